@@ -1,0 +1,1 @@
+"""The ``roverlab`` command line (typer + rich)."""

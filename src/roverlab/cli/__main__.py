@@ -1,0 +1,3 @@
+from roverlab.cli.main import main
+
+main()

@@ -1,0 +1,92 @@
+"""What every networked CLI command shares: how to join the running system."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, replace
+from typing import Any
+
+from roverlab.core import Context
+from roverlab.core.transport.daemon import ensure_daemon
+from roverlab.core.transport.zenoh import (
+    GraphEntity,
+    ZenohOptions,
+    ZenohTransport,
+    query_graph,
+)
+
+__all__ = ["Connection", "NetworkOptions", "wait_for_graph"]
+
+_SETTLE_S = 0.3
+
+
+@dataclass(frozen=True)
+class NetworkOptions:
+    """Connection settings from the root command's options."""
+
+    connect: tuple[str, ...] = ()
+    listen: tuple[str, ...] = ("tcp/127.0.0.1:0",)
+    user: str | None = None
+    password: str | None = None
+    tls_root_ca: str | None = None
+    tls_cert: str | None = None
+    tls_key: str | None = None
+    multicast: bool = False
+
+    def zenoh_options(self) -> ZenohOptions:
+        opts = ZenohOptions(
+            listen=self.listen,
+            connect=self.connect,
+            user=self.user,
+            password=self.password,
+            tls_root_ca=self.tls_root_ca,
+            tls_cert=self.tls_cert,
+            tls_key=self.tls_key,
+            multicast_scouting=self.multicast,
+        )
+        if not opts.connect and not self.multicast:
+            opts = replace(opts, connect=(ensure_daemon(),))
+        return opts
+
+
+class Connection:
+    """A wall-clock context joined to the network, for one CLI command."""
+
+    def __init__(self, options: NetworkOptions, *, clock: str = "wall") -> None:
+        self.context = Context(clock=clock, publish_clock=False)
+        self.transport = ZenohTransport(options.zenoh_options())
+        self.context.add_transport(self.transport)
+        # A fresh session's first graph or parameter query can come back empty until the
+        # router has sent it the network's declarations: give it that moment once.
+        time.sleep(_SETTLE_S)
+
+    def graph(self, timeout_s: float = 1.0) -> list[GraphEntity]:
+        """Nodes, publishers and subscriptions of the other processes."""
+        return [
+            e
+            for e in query_graph(self.transport.session, self.transport.domain, timeout_s)
+            if e.zid != self.transport.zid
+        ]
+
+    def close(self) -> None:
+        self.context.shutdown()
+
+    def __enter__(self) -> Connection:
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.close()
+
+
+def wait_for_graph(
+    conn: Connection, predicate: Any, timeout_s: float | None, poll_s: float = 0.2
+) -> list[GraphEntity]:
+    """Poll the graph until ``predicate(entities)`` holds or the timeout passes."""
+    deadline = None if timeout_s is None else time.monotonic() + timeout_s
+    while True:
+        ents = conn.graph(timeout_s=0.5)
+        if predicate(ents):
+            return ents
+        if deadline is not None and time.monotonic() >= deadline:
+            return ents
+        time.sleep(poll_s)

@@ -1,0 +1,100 @@
+"""``roverlab node`` and ``roverlab param``: the running system's nodes and parameters."""
+
+from __future__ import annotations
+
+from typing import Annotated, Any
+
+import typer
+import yaml
+
+from roverlab.cli.common import Connection, NetworkOptions
+from roverlab.core.errors import ParameterError
+from roverlab.core.transport.zenoh import query_parameters
+
+node_app = typer.Typer(help="Inspect nodes (rosnode / ros2 node).", no_args_is_help=True)
+param_app = typer.Typer(
+    help="Get, set and dump node parameters (rosparam / ros2 param).", no_args_is_help=True
+)
+
+
+def _options(ctx: typer.Context) -> NetworkOptions:
+    obj = ctx.find_root().obj
+    return obj if isinstance(obj, NetworkOptions) else NetworkOptions()
+
+
+@node_app.command("list")
+def node_list(ctx: typer.Context) -> None:
+    """List the nodes of every running roverlab process."""
+    with Connection(_options(ctx)) as conn:
+        names = sorted({e.node for e in conn.graph() if e.kind == "node"})
+    for name in names:
+        typer.echo(name)
+
+
+@node_app.command("info")
+def node_info(
+    ctx: typer.Context, node: Annotated[str, typer.Argument(help="Node name, e.g. /amcl.")]
+) -> None:
+    """Print a node's publishers and subscriptions."""
+    fq = node if node.startswith("/") else "/" + node
+    with Connection(_options(ctx)) as conn:
+        ents = [e for e in conn.graph() if e.node == fq]
+    if not ents:
+        raise ParameterError(f"node '{fq}' not found (is it running?)")
+    typer.echo(fq)
+    for kind, title in (("subscription", "Subscribers"), ("publisher", "Publishers")):
+        typer.echo(f"  {title}:")
+        for e in sorted((e for e in ents if e.kind == kind), key=lambda e: e.topic):
+            typer.echo(f"    {e.topic}: {e.typename}")
+
+
+def _ask(ctx: typer.Context, node: str, request: dict[str, Any]) -> dict[str, Any]:
+    with Connection(_options(ctx)) as conn:
+        answer = query_parameters(conn.transport.session, node, request, conn.transport.domain)
+    if "error" in answer:
+        raise ParameterError(str(answer["error"]))
+    return answer
+
+
+@param_app.command("list")
+def param_list(ctx: typer.Context, node: Annotated[str, typer.Argument(help="Node name.")]) -> None:
+    """List a node's parameter names."""
+    for name in _ask(ctx, node, {"op": "list"})["names"]:
+        typer.echo(f"  {name}")
+
+
+@param_app.command("get")
+def param_get(
+    ctx: typer.Context,
+    node: Annotated[str, typer.Argument(help="Node name.")],
+    name: Annotated[str, typer.Argument(help="Parameter name.")],
+) -> None:
+    """Print a parameter's value."""
+    value = _ask(ctx, node, {"op": "get", "name": name})["value"]
+    typer.echo(yaml.safe_dump(value, default_flow_style=True).strip().removesuffix("\n..."))
+
+
+@param_app.command("set")
+def param_set(
+    ctx: typer.Context,
+    node: Annotated[str, typer.Argument(help="Node name.")],
+    name: Annotated[str, typer.Argument(help="Parameter name.")],
+    value: Annotated[str, typer.Argument(help="New value, as YAML (0.5, true, [1, 2], text).")],
+) -> None:
+    """Set a parameter (its type must match the declared one)."""
+    try:
+        parsed = yaml.safe_load(value)
+    except yaml.YAMLError as err:
+        raise ParameterError(f"value {value!r} is not valid YAML") from err
+    answer = _ask(ctx, node, {"op": "set", "name": name, "value": parsed})
+    if not answer.get("ok", False):
+        raise ParameterError(f"setting parameter failed: {answer.get('reason') or 'rejected'}")
+    typer.echo("Set parameter successful")
+
+
+@param_app.command("dump")
+def param_dump(ctx: typer.Context, node: Annotated[str, typer.Argument(help="Node name.")]) -> None:
+    """Print a node's parameters as a ROS 2 parameter YAML file."""
+    params = _ask(ctx, node, {"op": "dump"})["parameters"]
+    fq = node if node.startswith("/") else "/" + node
+    typer.echo(yaml.safe_dump({fq: {"ros__parameters": params}}, sort_keys=False).rstrip())

@@ -1,0 +1,93 @@
+"""The ``roverlab`` command."""
+
+from __future__ import annotations
+
+import sys
+from typing import Annotated
+
+import typer
+
+from roverlab.cli import daemon, demo, graph, tf, topic
+from roverlab.cli.common import NetworkOptions
+from roverlab.errors import RoverlabError
+
+app = typer.Typer(
+    name="roverlab",
+    help="The classic ROS mobile-robot stack, pip-installable, no ROS needed.",
+    no_args_is_help=True,
+    pretty_exceptions_enable=False,
+    context_settings={"help_option_names": ["-h", "--help"]},
+)
+app.add_typer(topic.app, name="topic")
+app.add_typer(graph.node_app, name="node")
+app.add_typer(graph.param_app, name="param")
+app.add_typer(tf.app, name="tf")
+app.add_typer(daemon.app, name="daemon")
+app.command("demo")(demo.demo)
+
+
+@app.callback()
+def root(
+    ctx: typer.Context,
+    connect: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--connect",
+            "-e",
+            help="Zenoh endpoint to connect to, e.g. tcp/192.168.1.41:7447 (repeatable). "
+            "Default: the local daemon, started if needed.",
+            envvar="ROVERLAB_CONNECT",
+        ),
+    ] = None,
+    listen: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--listen",
+            "-l",
+            help="Zenoh endpoint to listen on (repeatable; default tcp/127.0.0.1:0).",
+            envvar="ROVERLAB_LISTEN",
+        ),
+    ] = None,
+    user: Annotated[
+        str | None, typer.Option("--user", help="Zenoh user name (user/password auth).")
+    ] = None,
+    password: Annotated[
+        str | None,
+        typer.Option("--password", help="Zenoh password.", envvar="ROVERLAB_PASSWORD"),
+    ] = None,
+    tls_root_ca: Annotated[
+        str | None, typer.Option("--tls-root-ca", help="CA certificate for tls/ endpoints.")
+    ] = None,
+    tls_cert: Annotated[
+        str | None, typer.Option("--tls-cert", help="Certificate for listening on tls/.")
+    ] = None,
+    tls_key: Annotated[
+        str | None, typer.Option("--tls-key", help="Private key for listening on tls/.")
+    ] = None,
+    multicast: Annotated[
+        bool,
+        typer.Option(
+            "--multicast", help="Find peers by UDP multicast on the LAN (off by default)."
+        ),
+    ] = False,
+) -> None:
+    """roverlab: simulate, map, localise, navigate and inspect robots the ROS way."""
+    ctx.obj = NetworkOptions(
+        connect=tuple(connect or ()),
+        listen=tuple(listen or ("tcp/127.0.0.1:0",)),
+        user=user,
+        password=password,
+        tls_root_ca=tls_root_ca,
+        tls_cert=tls_cert,
+        tls_key=tls_key,
+        multicast=multicast,
+    )
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Entry point: user errors become one line on stderr and exit code 2."""
+    try:
+        app(args=argv, prog_name="roverlab", standalone_mode=True)
+    except RoverlabError as err:
+        print(f"error: {err}", file=sys.stderr)
+        sys.exit(2)

@@ -1,0 +1,398 @@
+"""Node, Publisher, Subscription, Timer and Clock with the rclpy vocabulary."""
+
+from __future__ import annotations
+
+import difflib
+import threading
+from collections import deque
+from collections.abc import Callable, Iterable, Mapping
+from typing import TYPE_CHECKING, Any
+
+from roverlab.core.errors import ParameterError
+from roverlab.core.graph import Topic, resolve_name, validate_node_name
+from roverlab.core.log import NodeLogger
+from roverlab.core.parameters import (
+    Parameter,
+    ParameterDescriptor,
+    ParameterType,
+    SetCallback,
+    SetParametersResult,
+)
+from roverlab.core.qos import QoSProfile, qos_profile
+from roverlab.core.time import Duration, Time
+from roverlab.msgs import normalize_type_name, type_name
+
+if TYPE_CHECKING:
+    from roverlab.core.context import Context
+    from roverlab.core.executor import Executor
+
+__all__ = ["Clock", "Node", "Publisher", "Subscription", "Timer"]
+
+
+def message_type_name(msg_type: Any) -> str:
+    """Full ROS 2 type name of a factory, a rosbags class or a (ROS 1 or 2) type string."""
+    if isinstance(msg_type, str):
+        return normalize_type_name(msg_type)
+    return type_name(msg_type)
+
+
+class Clock:
+    """The node's view of the executor clock (ROS time: sim time inside a simulation)."""
+
+    def __init__(self, executor: Executor) -> None:
+        self._executor = executor
+
+    def now(self) -> Time:
+        return Time(self._executor.now_ns)
+
+    def now_ns(self) -> int:
+        return self._executor.now_ns
+
+
+class Publisher:
+    """Publishes on one topic; delivery to local subscriptions is by reference."""
+
+    def __init__(self, node: Node, topic: Topic, qos: QoSProfile) -> None:
+        self.node = node
+        self.topic = topic
+        self.topic_name = topic.name
+        self.qos = qos
+        self.history: deque[Any] | None = deque(maxlen=qos.depth) if qos.latched else None
+        self._executor = node.context.executor
+
+    def publish(self, msg: Any) -> None:
+        """Deliver ``msg`` to every subscription of the topic (and remote listeners).
+
+        Messages are passed by reference: treat a published message as read-only.
+        Safe to call from any thread; off the executor thread it is queued in.
+        """
+        ex = self._executor
+        tid = ex._thread_id
+        if tid is not None and tid != threading.get_ident():
+            ex.call_soon_threadsafe(lambda: self.publish(msg))
+            return
+        topic = self.topic
+        topic.published += 1
+        for sub in topic.subscriptions:
+            sub._enqueue(msg)
+        if self.history is not None:
+            self.history.append(msg)
+        send = topic.remote_send
+        if send is not None:
+            send(msg)
+
+    def get_subscription_count(self) -> int:
+        return len(self.topic.subscriptions)
+
+    def destroy(self) -> None:
+        self.node.destroy_publisher(self)
+
+
+class Subscription:
+    """A callback on one topic with a bounded queue (QoS history depth).
+
+    When more than ``depth`` messages wait for the callback, the oldest is dropped and
+    counted in ``dropped``.
+    """
+
+    def __init__(
+        self, node: Node, topic: Topic, callback: Callable[[Any], Any], qos: QoSProfile
+    ) -> None:
+        self.node = node
+        self.topic = topic
+        self.topic_name = topic.name
+        self.callback = callback
+        self.qos = qos
+        self.depth = qos.depth
+        self.dropped = 0
+        self.received = 0
+        self._queue: deque[Any] = deque(maxlen=qos.depth)
+        self._ready = node.context.executor._ready
+        self._seq = node.context.executor._seq
+        self._take_ref = self._take
+        self.active = True
+
+    def _enqueue(self, msg: Any) -> None:
+        q = self._queue
+        if len(q) == self.depth:
+            self.dropped += 1
+        q.append(msg)
+        self._ready.append((next(self._seq), self._take_ref))
+
+    def _take(self) -> None:
+        if self._queue and self.active:
+            self.received += 1
+            self.callback(self._queue.popleft())
+
+    def destroy(self) -> None:
+        self.node.destroy_subscription(self)
+
+
+class Timer:
+    """Calls ``callback()`` every ``period`` of clock time, without drift."""
+
+    def __init__(self, node: Node, period_ns: int, callback: Callable[[], Any]) -> None:
+        self.node = node
+        self.period_ns = period_ns
+        self.callback = callback
+        self._executor = node.context.executor
+        self._generation = 0
+        self.cancelled = False
+        self._schedule(self._executor.now_ns + period_ns)
+
+    @property
+    def timer_period_ns(self) -> int:
+        return self.period_ns
+
+    def _schedule(self, t_ns: int) -> None:
+        gen = self._generation
+        self._next_ns = t_ns
+
+        def fire() -> None:
+            if self.cancelled or gen != self._generation:
+                return
+            nxt = self._next_ns + self.period_ns
+            now = self._executor.now_ns
+            if nxt <= now:  # the clock jumped past whole periods: skip them, as rcl does
+                nxt += ((now - nxt) // self.period_ns + 1) * self.period_ns
+            self._schedule(nxt)
+            self.callback()
+
+        fire.__self__ = self  # type: ignore[attr-defined]  # lets errors name the owner
+        self._executor.call_at(t_ns, fire)
+
+    def cancel(self) -> None:
+        self.cancelled = True
+        self._generation += 1
+
+    def reset(self) -> None:
+        """Restart the period from now (and un-cancel), as rclpy Timer.reset."""
+        self.cancelled = False
+        self._generation += 1
+        self._schedule(self._executor.now_ns + self.period_ns)
+
+    def is_canceled(self) -> bool:
+        return self.cancelled
+
+    def time_until_next_call(self) -> int:
+        return max(0, self._next_ns - self._executor.now_ns)
+
+    def destroy(self) -> None:
+        self.node.destroy_timer(self)
+
+
+class Node:
+    """A ROS node: publishers, subscriptions, timers, parameters, clock and logger.
+
+    Args:
+        node_name: the node's name (letters, digits, ``_``).
+        context: the :class:`~roverlab.core.context.Context` (graph + executor) it joins.
+        namespace: prefix of relative topic names.
+        parameter_overrides: values for parameters this node declares (from a launch file
+            or YAML). An override the node never declares is an error when the context
+            starts spinning (:meth:`check_parameter_overrides`).
+        remappings: ``{from: to}`` topic renames, as ``<remap>`` in a launch file.
+    """
+
+    def __init__(
+        self,
+        node_name: str,
+        *,
+        context: Context,
+        namespace: str = "/",
+        parameter_overrides: Mapping[str, Any] | None = None,
+        remappings: Mapping[str, str] | None = None,
+    ) -> None:
+        self._name = validate_node_name(node_name)
+        self._namespace = "/" + namespace.strip("/") if namespace.strip("/") else "/"
+        self.context = context
+        self._clock = Clock(context.executor)
+        self._logger = NodeLogger(self.get_fully_qualified_name(), self._stamp)
+        self._overrides = dict(parameter_overrides or {})
+        self._remap = {
+            resolve_name(k, self._namespace, node_name): resolve_name(v, self._namespace, node_name)
+            for k, v in (remappings or {}).items()
+        }
+        self._parameters: dict[str, Parameter] = {}
+        self._set_callbacks: list[SetCallback] = []
+        self.publishers: list[Publisher] = []
+        self.subscriptions: list[Subscription] = []
+        self.timers: list[Timer] = []
+        self._destroyed = False
+        context._add_node(self)
+        self.declare_parameter("use_sim_time", context.uses_sim_time)
+
+    # ----------------------------------------------------------------- names
+    def get_name(self) -> str:
+        return self._name
+
+    def get_namespace(self) -> str:
+        return self._namespace
+
+    def get_fully_qualified_name(self) -> str:
+        return self._namespace.rstrip("/") + "/" + self._name
+
+    def resolve_topic_name(self, topic: str) -> str:
+        full = resolve_name(topic, self._namespace, self._name)
+        return self._remap.get(full, full)
+
+    def _stamp(self) -> float:
+        return self.context.executor.now_ns / 1e9
+
+    def get_clock(self) -> Clock:
+        return self._clock
+
+    def get_logger(self) -> NodeLogger:
+        return self._logger
+
+    # ----------------------------------------------------------------- pub/sub/timers
+    def create_publisher(
+        self, msg_type: Any, topic: str, qos_profile_or_depth: QoSProfile | int = 10
+    ) -> Publisher:
+        qos = qos_profile(qos_profile_or_depth)
+        t = self.context.graph.get(self.resolve_topic_name(topic), message_type_name(msg_type))
+        pub = Publisher(self, t, qos)
+        t.publishers.append(pub)
+        self.publishers.append(pub)
+        self.context._on_publisher(pub)
+        return pub
+
+    def create_subscription(
+        self,
+        msg_type: Any,
+        topic: str,
+        callback: Callable[[Any], Any],
+        qos_profile_or_depth: QoSProfile | int = 10,
+    ) -> Subscription:
+        qos = qos_profile(qos_profile_or_depth)
+        t = self.context.graph.get(self.resolve_topic_name(topic), message_type_name(msg_type))
+        sub = Subscription(self, t, callback, qos)
+        t.subscriptions.append(sub)
+        self.subscriptions.append(sub)
+        # Latched (transient-local) history reaches every late subscriber, as ROS 1's
+        # latched topics do (ROS 2 also wants the subscriber transient-local; being
+        # lenient here saves the usual "why is /map empty" question).
+        for msg in t.latched_history():
+            sub._enqueue(msg)
+        self.context._on_subscription(sub)
+        return sub
+
+    def create_timer(self, timer_period_sec: float, callback: Callable[[], Any]) -> Timer:
+        period = Duration.from_seconds(timer_period_sec).nanoseconds
+        if period <= 0:
+            raise ValueError(f"timer period must be > 0 s, got {timer_period_sec}")
+        timer = Timer(self, period, callback)
+        self.timers.append(timer)
+        return timer
+
+    def destroy_publisher(self, pub: Publisher) -> None:
+        if pub in self.publishers:
+            self.publishers.remove(pub)
+            pub.topic.publishers.remove(pub)
+            self.context._on_publisher_removed(pub)
+
+    def destroy_subscription(self, sub: Subscription) -> None:
+        if sub in self.subscriptions:
+            sub.active = False
+            self.subscriptions.remove(sub)
+            sub.topic.subscriptions.remove(sub)
+            self.context._on_subscription_removed(sub)
+
+    def destroy_timer(self, timer: Timer) -> None:
+        timer.cancel()
+        if timer in self.timers:
+            self.timers.remove(timer)
+
+    def destroy_node(self) -> None:
+        if self._destroyed:
+            return
+        for pub in list(self.publishers):
+            self.destroy_publisher(pub)
+        for sub in list(self.subscriptions):
+            self.destroy_subscription(sub)
+        for timer in list(self.timers):
+            self.destroy_timer(timer)
+        self._destroyed = True
+        self.context._remove_node(self)
+
+    # ----------------------------------------------------------------- parameters
+    def declare_parameter(
+        self,
+        name: str,
+        value: Any = None,
+        descriptor: ParameterDescriptor | None = None,
+        *,
+        ignore_override: bool = False,
+    ) -> Parameter:
+        """Declare a parameter; its type is the default's type and is fixed from then on.
+
+        An override from a launch file or YAML replaces the default (validated).
+        """
+        if name in self._parameters:
+            raise ParameterError(f"node '{self._name}': parameter '{name}' declared twice")
+        ptype = ParameterType.of(value)
+        param = Parameter(name, ptype, value, descriptor or ParameterDescriptor())
+        if ptype is not ParameterType.NOT_SET:
+            param.value = param.validate(value)
+        if not ignore_override and name in self._overrides:
+            try:
+                param.value = param.validate(self._overrides[name])
+            except ParameterError as err:
+                raise ParameterError(f"node '{self._name}': {err}") from err
+        self._parameters[name] = param
+        return param
+
+    def declare_parameters(
+        self, namespace: str, parameters: Iterable[tuple[str, Any]]
+    ) -> list[Parameter]:
+        prefix = f"{namespace}." if namespace else ""
+        return [self.declare_parameter(prefix + n, v) for n, v in parameters]
+
+    def has_parameter(self, name: str) -> bool:
+        return name in self._parameters
+
+    def get_parameter(self, name: str) -> Parameter:
+        try:
+            return self._parameters[name]
+        except KeyError:
+            raise ParameterError(self._unknown_parameter(name)) from None
+
+    def get_parameters(self, names: Iterable[str]) -> list[Parameter]:
+        return [self.get_parameter(n) for n in names]
+
+    def get_parameter_value(self, name: str) -> Any:
+        return self.get_parameter(name).value
+
+    @property
+    def parameters(self) -> Mapping[str, Parameter]:
+        return self._parameters
+
+    def set_parameter(self, name: str, value: Any) -> SetParametersResult:
+        """Set one declared parameter; raises ParameterError if unknown or mistyped."""
+        param = self.get_parameter(name)
+        if param.descriptor.read_only:
+            raise ParameterError(f"node '{self._name}': parameter '{name}' is read-only")
+        new = Parameter(name, param.type, param.validate(value), param.descriptor)
+        for cb in self._set_callbacks:
+            result = cb([new])
+            if not result.successful:
+                return result
+        param.value = new.value
+        return SetParametersResult(True)
+
+    def set_parameters(self, parameters: Iterable[Parameter]) -> list[SetParametersResult]:
+        return [self.set_parameter(p.name, p.value) for p in parameters]
+
+    def add_on_set_parameters_callback(self, callback: SetCallback) -> None:
+        self._set_callbacks.append(callback)
+
+    def _unknown_parameter(self, name: str) -> str:
+        near = difflib.get_close_matches(name, list(self._parameters), n=1)
+        hint = f" (did you mean '{near[0]}'?)" if near else ""
+        return f"node '{self._name}' has no parameter '{name}'{hint}"
+
+    def check_parameter_overrides(self) -> None:
+        """Raise ParameterError for an override that names no declared parameter."""
+        for name in self._overrides:
+            if name not in self._parameters:
+                raise ParameterError(self._unknown_parameter(name))

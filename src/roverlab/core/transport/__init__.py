@@ -1,0 +1,1 @@
+"""Transports that carry a context's topics beyond its process (Zenoh)."""

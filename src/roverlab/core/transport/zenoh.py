@@ -1,0 +1,464 @@
+"""Zenoh transport: the same nodes across processes and machines.
+
+Key layout (``D`` is the domain, ``ROVERLAB_DOMAIN_ID``, default 0; like ``ROS_DOMAIN_ID``):
+
+=====================================  ================================================
+``rl/D/t/<topic>``                     messages: topic ``/scan`` -> ``rl/0/t/scan``;
+                                       payload = ROS 2 CDR bytes (with the 4-byte
+                                       encapsulation header); encoding
+                                       ``application/cdr;<type name>``
+``rl/D/l/<topic>/<zid>``               queryable of a latched (transient-local)
+                                       publisher's history, read by late subscribers
+``rl/D/g/<zid>/<kind>/<node>/...``     liveliness tokens of the graph: ``n`` nodes,
+                                       ``p`` publishers and ``s`` subscriptions
+                                       (``.../<topic>/<type>``); ``/`` in names is
+                                       written ``%``
+``rl/D/p/<node>``                      parameter service of a node (JSON queries)
+=====================================  ================================================
+
+Messages that stay inside a process never touch Zenoh: a topic is serialised only while
+a subscriber in another process matches it.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import socket
+import tempfile
+import threading
+from dataclasses import dataclass, field
+from functools import partial
+from typing import TYPE_CHECKING, Any
+
+import zenoh
+
+from roverlab.core.errors import ParameterError, TransportError
+from roverlab.msgs import deserialize, serialize
+
+if TYPE_CHECKING:
+    from roverlab.core.context import Context
+    from roverlab.core.node import Node, Publisher, Subscription
+
+__all__ = [
+    "DEFAULT_DAEMON_ENDPOINT",
+    "GraphEntity",
+    "ZenohOptions",
+    "ZenohTransport",
+    "daemon_endpoint",
+    "decode_name",
+    "encode_name",
+    "open_session",
+    "query_graph",
+    "query_parameters",
+    "topic_key",
+]
+
+DEFAULT_DAEMON_ENDPOINT = "tcp/127.0.0.1:7447"
+
+
+def daemon_endpoint() -> str:
+    """The roverlab daemon's endpoint: ``ROVERLAB_DAEMON`` or tcp/127.0.0.1:7447."""
+    return os.environ.get("ROVERLAB_DAEMON", DEFAULT_DAEMON_ENDPOINT)
+
+
+def domain_id() -> int:
+    raw = os.environ.get("ROVERLAB_DOMAIN_ID", "0")
+    try:
+        return int(raw)
+    except ValueError:
+        raise TransportError(f"ROVERLAB_DOMAIN_ID must be an integer, got {raw!r}") from None
+
+
+def encode_name(name: str) -> str:
+    """A ROS name as one Zenoh key chunk ('/' -> '%')."""
+    return name.replace("/", "%")
+
+
+def decode_name(chunk: str) -> str:
+    return chunk.replace("%", "/")
+
+
+def topic_key(topic: str, domain: int = 0) -> str:
+    return f"rl/{domain}/t/{topic.lstrip('/')}"
+
+
+@dataclass(frozen=True)
+class ZenohOptions:
+    """How a process joins the Zenoh network.
+
+    Defaults are safe: peer mode, listening on 127.0.0.1 only, multicast scouting off.
+    Two machines need an explicit ``listen`` on one (``tcp/0.0.0.0:7447``) and
+    ``connect`` on the other (``tcp/192.168.1.41:7447``).
+
+    Args:
+        mode: ``peer`` (default), ``client`` or ``router``.
+        listen: endpoints to listen on.
+        connect: endpoints to connect to.
+        multicast_scouting: let Zenoh find peers by UDP multicast on the LAN.
+        user, password: user/password authentication (both sides must use the same).
+        tls_root_ca, tls_cert, tls_key: files for ``tls/`` endpoints (server cert and
+            key where this side listens; the CA that signed the other side's cert).
+    """
+
+    mode: str = "peer"
+    listen: tuple[str, ...] = ("tcp/127.0.0.1:0",)
+    connect: tuple[str, ...] = ()
+    multicast_scouting: bool = False
+    user: str | None = None
+    password: str | None = None
+    tls_root_ca: str | None = None
+    tls_cert: str | None = None
+    tls_key: str | None = None
+    domain: int = field(default_factory=domain_id)
+
+    def to_config(self) -> tuple[zenoh.Config, list[str]]:
+        """The Zenoh config, plus temporary files it refers to (to delete at close)."""
+        if self.mode not in ("peer", "client", "router"):
+            raise TransportError(f"unknown Zenoh mode {self.mode!r} (peer, client or router)")
+        if (self.user is None) != (self.password is None):
+            raise TransportError("Zenoh authentication needs both --user and --password")
+        cfg = zenoh.Config()
+        temps: list[str] = []
+
+        def put(key: str, value: Any) -> None:
+            try:
+                cfg.insert_json5(key, json.dumps(value))
+            except Exception as err:
+                raise TransportError(f"invalid Zenoh setting {key}={value!r}: {err}") from err
+
+        put("mode", self.mode)
+        put("listen/endpoints", list(self.listen))
+        put("connect/endpoints", list(self.connect))
+        put("scouting/multicast/enabled", self.multicast_scouting)
+        if self.user is not None:
+            fd, path = tempfile.mkstemp(prefix="roverlab-zenoh-auth-", text=True)
+            with os.fdopen(fd, "w") as fh:
+                fh.write(f"{self.user}:{self.password}\n")
+            temps.append(path)
+            put("transport/auth/usrpwd/user", self.user)
+            put("transport/auth/usrpwd/password", self.password)
+            put("transport/auth/usrpwd/dictionary_file", path)
+        if self.tls_root_ca is not None:
+            put("transport/link/tls/root_ca_certificate", self.tls_root_ca)
+        if self.tls_cert is not None:
+            put("transport/link/tls/listen_certificate", self.tls_cert)
+        if self.tls_key is not None:
+            put("transport/link/tls/listen_private_key", self.tls_key)
+        return cfg, temps
+
+
+def open_session(options: ZenohOptions) -> tuple[zenoh.Session, list[str]]:
+    cfg, temps = options.to_config()
+    try:
+        return zenoh.open(cfg), temps
+    except Exception as err:
+        for path in temps:
+            os.unlink(path)
+        raise TransportError(f"cannot open Zenoh session: {err}") from err
+
+
+def endpoint_reachable(endpoint: str, timeout_s: float = 0.2) -> bool:
+    """True if a TCP endpoint ``tcp/host:port`` accepts connections."""
+    proto, _, addr = endpoint.partition("/")
+    if proto not in ("tcp", "tls"):
+        return False
+    host, _, port = addr.rpartition(":")
+    try:
+        with socket.create_connection((host.strip("[]"), int(port)), timeout=timeout_s):
+            return True
+    except (OSError, ValueError):
+        return False
+
+
+class _TopicLink:
+    """Zenoh entities of one local topic."""
+
+    def __init__(self) -> None:
+        self.publisher: Any = None
+        self.matching: Any = None
+        self.subscriber: Any = None
+        self.latched_queryable: Any = None
+        self.tokens: dict[object, Any] = {}
+
+
+class ZenohTransport:
+    """Mirrors a context's topics, graph and parameters over a Zenoh session."""
+
+    def __init__(self, options: ZenohOptions | None = None) -> None:
+        self.options = options or ZenohOptions()
+        self.session, self._temps = open_session(self.options)
+        self.zid = str(self.session.zid())
+        self.domain = self.options.domain
+        self._context: Context | None = None
+        self._links: dict[str, _TopicLink] = {}
+        self._node_entities: dict[str, list[Any]] = {}
+        self._lock = threading.Lock()
+        self.received = 0
+        self.sent = 0
+        self.dropped_wrong_type = 0
+
+    # ----------------------------------------------------------------- keys
+    def _g(self, kind: str, *parts: str) -> str:
+        return f"rl/{self.domain}/g/{self.zid}/{kind}/" + "/".join(encode_name(p) for p in parts)
+
+    def _link(self, topic: str) -> _TopicLink:
+        link = self._links.get(topic)
+        if link is None:
+            link = _TopicLink()
+            self._links[topic] = link
+        return link
+
+    # ----------------------------------------------------------------- Transport protocol
+    def attach(self, context: Context) -> None:
+        self._context = context
+
+    def on_node(self, node: Node, added: bool) -> None:
+        fq = node.get_fully_qualified_name()
+        with self._lock:
+            if added:
+                token = self.session.liveliness().declare_token(self._g("n", fq))
+                queryable = self.session.declare_queryable(
+                    f"rl/{self.domain}/p/{encode_name(fq)}",
+                    partial(self._on_param_query, node),
+                )
+                self._node_entities[fq] = [token, queryable]
+            else:
+                for ent in self._node_entities.pop(fq, []):
+                    ent.undeclare()
+
+    def on_publisher(self, pub: Publisher, added: bool) -> None:
+        topic = pub.topic
+        with self._lock:
+            link = self._link(topic.name)
+            if added:
+                link.tokens[pub] = self.session.liveliness().declare_token(
+                    self._g("p", pub.node.get_fully_qualified_name(), topic.name, topic.typename)
+                    + ("/latched" if pub.qos.latched else "/volatile")
+                )
+                if link.publisher is None:
+                    self._declare_publisher(topic, link)
+                if pub.qos.latched and link.latched_queryable is None:
+                    key = f"rl/{self.domain}/l/{topic.name.lstrip('/')}/{self.zid}"
+                    link.latched_queryable = self.session.declare_queryable(
+                        key, partial(self._on_latched_query, topic)
+                    )
+            else:
+                tok = link.tokens.pop(pub, None)
+                if tok is not None:
+                    tok.undeclare()
+                if not topic.publishers and link.publisher is not None:
+                    topic.remote_send = None
+                    link.matching.undeclare()
+                    link.publisher.undeclare()
+                    link.publisher = link.matching = None
+                latched_left = any(p.history is not None for p in topic.publishers)
+                if link.latched_queryable is not None and not latched_left:
+                    link.latched_queryable.undeclare()
+                    link.latched_queryable = None
+
+    def on_subscription(self, sub: Subscription, added: bool) -> None:
+        topic = sub.topic
+        with self._lock:
+            link = self._link(topic.name)
+            if added:
+                link.tokens[sub] = self.session.liveliness().declare_token(
+                    self._g("s", sub.node.get_fully_qualified_name(), topic.name, topic.typename)
+                )
+                if link.subscriber is None:
+                    link.subscriber = self.session.declare_subscriber(
+                        topic_key(topic.name, self.domain),
+                        partial(self._on_sample, topic),
+                        allowed_origin=zenoh.Locality.REMOTE,
+                    )
+                self._fetch_latched(topic, sub)
+            else:
+                tok = link.tokens.pop(sub, None)
+                if tok is not None:
+                    tok.undeclare()
+                if not topic.subscriptions and link.subscriber is not None:
+                    link.subscriber.undeclare()
+                    link.subscriber = None
+
+    def close(self) -> None:
+        with self._lock:
+            self._links.clear()
+            self._node_entities.clear()
+        try:
+            self.session.close()
+        finally:
+            for path in self._temps:
+                with contextlib.suppress(OSError):
+                    os.unlink(path)
+            self._temps = []
+
+    # ----------------------------------------------------------------- data path
+    def _declare_publisher(self, topic: Any, link: _TopicLink) -> None:
+        encoding = zenoh.Encoding.APPLICATION_CDR.with_schema(topic.typename)
+        zpub = self.session.declare_publisher(
+            topic_key(topic.name, self.domain),
+            encoding=encoding,
+            allowed_destination=zenoh.Locality.REMOTE,
+            congestion_control=zenoh.CongestionControl.BLOCK,
+        )
+
+        def send(msg: Any) -> None:
+            zpub.put(serialize(msg))
+            self.sent += 1
+
+        def on_matching(status: Any) -> None:
+            topic.remote_send = send if status.matching else None
+
+        link.publisher = zpub
+        link.matching = zpub.declare_matching_listener(on_matching)
+        if zpub.matching_status:
+            topic.remote_send = send
+
+    def _on_sample(self, topic: Any, sample: Any) -> None:
+        # Zenoh's thread only copies the bytes out; the executor thread deserialises, so
+        # the two threads hand the GIL over once per message, not twice.
+        ctx = self._context
+        if ctx is not None:
+            ctx.executor.call_soon_threadsafe(
+                partial(self._deliver_bytes, topic, sample.payload.to_bytes())
+            )
+
+    def _deliver_bytes(self, topic: Any, data: bytes) -> None:
+        try:
+            msg = deserialize(data, topic.typename)
+        except Exception:
+            # another process publishes this topic with a different type: count and
+            # drop, as DDS drops samples of a mismatched type
+            self.dropped_wrong_type += 1
+            return
+        self.received += 1
+        for sub in topic.subscriptions:
+            sub._enqueue(msg)
+
+    def _on_latched_query(self, topic: Any, query: Any) -> None:
+        for msg in topic.latched_history():
+            query.reply(query.key_expr, serialize(msg))
+
+    def _fetch_latched(self, topic: Any, sub: Subscription) -> None:
+        """Ask other processes' latched publishers of this topic for their history."""
+        selector = f"rl/{self.domain}/l/{topic.name.lstrip('/')}/*"
+        ctx = self._context
+
+        def on_reply(reply: Any) -> None:
+            if reply.ok is None or ctx is None:
+                return
+            try:
+                msg = deserialize(reply.ok.payload.to_bytes(), topic.typename)
+            except Exception:
+                return
+            ctx.executor.call_soon_threadsafe(lambda: sub._enqueue(msg))
+
+        self.session.get(selector, on_reply, timeout=2.0)
+
+    # ----------------------------------------------------------------- parameters
+    def _on_param_query(self, node: Node, query: Any) -> None:
+        try:
+            request = json.loads(query.payload.to_bytes()) if query.payload is not None else {}
+            answer = self._param_answer(node, request)
+        except Exception as err:  # any bad request gets an error reply, never a crash
+            answer = {"error": str(err)}
+        query.reply(query.key_expr, json.dumps(answer))
+
+    def _param_answer(self, node: Node, request: dict[str, Any]) -> dict[str, Any]:
+        op = request.get("op")
+        if op == "list":
+            return {"names": sorted(node.parameters)}
+        if op == "get":
+            name = str(request.get("name"))
+            return {"name": name, "value": node.get_parameter(name).value}
+        if op == "dump":
+            return {"parameters": {n: p.value for n, p in sorted(node.parameters.items())}}
+        if op == "set":
+            name = str(request.get("name"))
+            value = request.get("value")
+            done = threading.Event()
+            result: dict[str, Any] = {}
+
+            def apply() -> None:
+                try:
+                    r = node.set_parameter(name, value)
+                    result.update({"ok": r.successful, "reason": r.reason})
+                except ParameterError as err:
+                    result.update({"error": str(err)})
+                done.set()
+
+            ctx = self._context
+            if ctx is None:
+                return {"error": "no context"}
+            ctx.executor.call_soon_threadsafe(apply)
+            if not done.wait(5.0):
+                return {"error": f"node '{node.get_name()}' did not answer (executor busy?)"}
+            return result
+        return {"error": f"unknown parameter operation {op!r}"}
+
+
+# ===================================================================== graph queries
+@dataclass(frozen=True)
+class GraphEntity:
+    """One liveliness token of the graph, decoded."""
+
+    zid: str
+    kind: str  # "node", "publisher" or "subscription"
+    node: str
+    topic: str = ""
+    typename: str = ""
+    latched: bool = False
+
+
+def parse_graph_key(key: str) -> GraphEntity | None:
+    parts = key.split("/")
+    # rl / D / g / zid / kind / node [/ topic / type [/ durability]]
+    if len(parts) < 6 or parts[0] != "rl" or parts[2] != "g":
+        return None
+    zid, kind, node = parts[3], parts[4], decode_name(parts[5])
+    if kind == "n":
+        return GraphEntity(zid, "node", node)
+    if kind in ("p", "s") and len(parts) >= 8:
+        return GraphEntity(
+            zid,
+            "publisher" if kind == "p" else "subscription",
+            node,
+            decode_name(parts[6]),
+            decode_name(parts[7]),
+            latched=len(parts) > 8 and parts[8] == "latched",
+        )
+    return None
+
+
+def query_graph(
+    session: zenoh.Session, domain: int = 0, timeout_s: float = 1.0
+) -> list[GraphEntity]:
+    """Every node, publisher and subscription visible on the network."""
+    out: list[GraphEntity] = []
+    for reply in session.liveliness().get(f"rl/{domain}/g/**", timeout=timeout_s):
+        if reply.ok is not None:
+            ent = parse_graph_key(str(reply.ok.key_expr))
+            if ent is not None:
+                out.append(ent)
+    return out
+
+
+def query_parameters(
+    session: zenoh.Session,
+    node: str,
+    request: dict[str, Any],
+    domain: int = 0,
+    timeout_s: float = 3.0,
+) -> dict[str, Any]:
+    """Send a parameter request (``{"op": "get"|"set"|"list"|"dump", ...}``) to a node."""
+    fq = node if node.startswith("/") else "/" + node
+    answers: list[dict[str, Any]] = []
+    for reply in session.get(
+        f"rl/{domain}/p/{encode_name(fq)}", payload=json.dumps(request), timeout=timeout_s
+    ):
+        if reply.ok is not None:
+            answers.append(json.loads(reply.ok.payload.to_bytes()))
+    if not answers:
+        raise ParameterError(f"node '{fq}' not found (is it running?)")
+    return answers[0]

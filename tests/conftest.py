@@ -1,0 +1,73 @@
+"""Shared fixtures: an isolated roverlab daemon per test session, child processes."""
+
+from __future__ import annotations
+
+import os
+import socket
+import subprocess
+import sys
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+from tests.helpers.procs import Proc
+
+HELPERS = Path(__file__).parent / "helpers"
+REPO = Path(__file__).resolve().parents[1]
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return int(s.getsockname()[1])
+
+
+@pytest.fixture(scope="session")
+def daemon(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
+    """A daemon on a free loopback port; ROVERLAB_DAEMON points every process at it."""
+    from roverlab.core.transport.daemon import ensure_daemon, stop_daemon
+
+    endpoint = f"tcp/127.0.0.1:{_free_port()}"
+    old = os.environ.get("ROVERLAB_DAEMON")
+    os.environ["ROVERLAB_DAEMON"] = endpoint
+    os.environ["ROVERLAB_LOG_DIR"] = str(tmp_path_factory.mktemp("log"))
+    ensure_daemon(endpoint)
+    yield endpoint
+    stop_daemon(endpoint)
+    if old is None:
+        os.environ.pop("ROVERLAB_DAEMON", None)
+    else:
+        os.environ["ROVERLAB_DAEMON"] = old
+
+
+@pytest.fixture
+def node_proc(daemon: str) -> Iterator[object]:
+    """Start ``tests/helpers/node_proc.py MODE`` processes; stopped at teardown."""
+    procs: list[Proc] = []
+
+    def start(mode: str) -> Proc:
+        p = Proc([sys.executable, str(HELPERS / "node_proc.py"), mode])
+        procs.append(p)
+        assert p.wait_line(lambda line: line.startswith("READY")) == "READY"
+        return p
+
+    yield start
+    for p in procs:
+        p.stop()
+
+
+@pytest.fixture
+def cli(daemon: str) -> object:
+    """Run ``roverlab ARGS`` in a subprocess; returns CompletedProcess."""
+
+    def run(*args: str, timeout: float = 30.0) -> subprocess.CompletedProcess[str]:
+        return subprocess.run(
+            [sys.executable, "-m", "roverlab.cli", *args],
+            capture_output=True,
+            text=True,
+            timeout=timeout,
+            env=dict(os.environ),
+        )
+
+    return run

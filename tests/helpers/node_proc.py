@@ -1,0 +1,55 @@
+"""A roverlab process for transport tests: ``python node_proc.py MODE``.
+
+Modes: talker (/chatter at 50 Hz), pong (echo /ping to /pong), clock (paced sim
+publishing /clock), latched (/map latched once), listener (print /cmd_vel as lines).
+Prints READY on stdout once its nodes exist.
+"""
+
+from __future__ import annotations
+
+import sys
+
+from roverlab.core import Context, QoSProfile
+from roverlab.core.transport.daemon import connect_context
+from roverlab.msgs import String, Twist
+
+
+def main(mode: str) -> None:
+    ctx = Context(clock="paced" if mode == "clock" else "wall", publish_clock=mode == "clock")
+    node = ctx.create_node(f"proc_{mode}")
+    node.declare_parameter("gain", 1.5)
+    if mode == "talker":
+        pub = node.create_publisher(String, "/chatter", 10)
+        count = [0]
+
+        def tick() -> None:
+            pub.publish(String(data=f"hello world {count[0]}"))
+            count[0] += 1
+
+        node.create_timer(0.02, tick)
+    elif mode == "pong":
+        pong = node.create_publisher(String, "/pong", 1000)
+        node.create_subscription(String, "/ping", pong.publish, 1000)
+    elif mode == "latched":
+        pub = node.create_publisher(
+            String, "/map", QoSProfile(depth=1, durability="transient_local")
+        )
+        pub.publish(String(data="the map"))
+    elif mode == "listener":
+
+        def show(m: object) -> None:
+            print(f"cmd_vel {m.linear.x:.3f} {m.angular.z:.3f}", flush=True)  # type: ignore[attr-defined]
+
+        node.create_subscription(Twist, "/cmd_vel", show, 10)
+    connect_context(ctx)
+    print("READY", flush=True)
+    try:
+        ctx.spin()
+    except KeyboardInterrupt:
+        pass
+    finally:
+        ctx.shutdown()
+
+
+if __name__ == "__main__":
+    main(sys.argv[1])
