@@ -10,6 +10,7 @@ import typer
 from roverlab.cli import daemon, demo, graph, tf, topic
 from roverlab.cli.common import NetworkOptions
 from roverlab.errors import RoverlabError
+from roverlab.teleop import cli as teleop_cli
 
 app = typer.Typer(
     name="roverlab",
@@ -24,6 +25,7 @@ app.add_typer(graph.param_app, name="param")
 app.add_typer(tf.app, name="tf")
 app.add_typer(daemon.app, name="daemon")
 app.command("demo")(demo.demo)
+app.command("teleop")(teleop_cli.teleop)
 
 
 @app.callback()

@@ -20,7 +20,7 @@ from typing import Any
 
 from ._store import STORE, normalize_type_name
 from ._values import from_dict, messages_equal, to_dict
-from .cdr import cdr_size, deserialize, serialize
+from .cdr import cdr_size, deserialize, message_definition, serialize
 from .convert import (
     array_to_image,
     array_to_occupancy_grid,
@@ -241,6 +241,7 @@ __all__ = [
     "image_to_array",
     "make",
     "make_scan",
+    "message_definition",
     "messages_equal",
     "normalize_type_name",
     "occupancy_grid_to_array",

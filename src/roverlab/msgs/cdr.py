@@ -13,10 +13,10 @@ from typing import Any, Final
 
 from rosbags.serde import SerdeError
 
-from ._store import STORE
+from ._store import STORE, normalize_type_name
 from .errors import SerializationError
 
-__all__ = ["cdr_size", "deserialize", "serialize"]
+__all__ = ["cdr_size", "deserialize", "message_definition", "serialize"]
 
 _ERRORS: Final = (
     struct.error,
@@ -139,3 +139,10 @@ def cdr_size(msg: Any) -> int:
     """Size in bytes of ``serialize(msg)``, without serialising."""
     typename = STORE.resolve(type(msg))
     return 4 + int(STORE.typestore.get_msgdef(typename).getsize_cdr(0, msg, STORE.typestore))
+
+
+def message_definition(typename: str) -> str:
+    """The ``.msg`` text of a type with its dependencies (the ``ros2msg`` schema of MCAP
+    files and ROS 2 bags)."""
+    text, _ = STORE.typestore.generate_msgdef(normalize_type_name(typename))
+    return str(text)

@@ -1,0 +1,194 @@
+"""Robot footprint against the world: a compiled polygon-vs-walls test and contact motion."""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+from numpy.typing import NDArray
+
+from roverlab.geometry import wrap_angle
+from roverlab.raycast.scene import Scene
+
+__all__ = ["Obstacles", "circle_polygon", "polygon_hits"]
+
+F64 = NDArray[np.float64]
+
+
+@numba.njit(cache=True, nogil=True)
+def _cross(ax: float, ay: float, bx: float, by: float) -> float:
+    return ax * by - ay * bx
+
+
+@numba.njit(cache=True, nogil=True)
+def _segments_intersect(
+    p0x: float, p0y: float, p1x: float, p1y: float, q0x: float, q0y: float, q1x: float, q1y: float
+) -> bool:
+    rx, ry = p1x - p0x, p1y - p0y
+    sx, sy = q1x - q0x, q1y - q0y
+    den = _cross(rx, ry, sx, sy)
+    qpx, qpy = q0x - p0x, q0y - p0y
+    if abs(den) < 1e-15:
+        # parallel: overlapping only if collinear and the projections overlap
+        if abs(_cross(qpx, qpy, rx, ry)) > 1e-12:
+            return False
+        rr = rx * rx + ry * ry
+        if rr < 1e-18:
+            return False
+        t0 = (qpx * rx + qpy * ry) / rr
+        t1 = t0 + (sx * rx + sy * ry) / rr
+        lo, hi = min(t0, t1), max(t0, t1)
+        return hi >= 0.0 and lo <= 1.0
+    t = _cross(qpx, qpy, sx, sy) / den
+    u = _cross(qpx, qpy, rx, ry) / den
+    return 0.0 <= t <= 1.0 and 0.0 <= u <= 1.0
+
+
+@numba.njit(cache=True, nogil=True)
+def _inside(poly: np.ndarray, x: float, y: float) -> bool:
+    n = poly.shape[0]
+    inside = False
+    j = n - 1
+    for i in range(n):
+        xi, yi = poly[i, 0], poly[i, 1]
+        xj, yj = poly[j, 0], poly[j, 1]
+        if (yi > y) != (yj > y):
+            xc = xi + (y - yi) * (xj - xi) / (yj - yi)
+            if x < xc:
+                inside = not inside
+        j = i
+    return inside
+
+
+@numba.njit(cache=True, nogil=True)
+def _point_segment_dist2(px: float, py: float, ax: float, ay: float, bx: float, by: float) -> float:
+    dx, dy = bx - ax, by - ay
+    ll = dx * dx + dy * dy
+    t = 0.0
+    if ll > 0.0:
+        t = ((px - ax) * dx + (py - ay) * dy) / ll
+        t = min(1.0, max(0.0, t))
+    cx, cy = ax + t * dx - px, ay + t * dy - py
+    return cx * cx + cy * cy
+
+
+@numba.njit(cache=True, nogil=True)
+def polygon_hits(poly: np.ndarray, segments: np.ndarray, circles: np.ndarray) -> bool:
+    """True if the closed polygon ``poly`` (K, 2) touches any segment or circle."""
+    k = poly.shape[0]
+    xmin, ymin = poly[:, 0].min(), poly[:, 1].min()
+    xmax, ymax = poly[:, 0].max(), poly[:, 1].max()
+    for i in range(segments.shape[0]):
+        ax, ay, bx, by = segments[i, 0], segments[i, 1], segments[i, 2], segments[i, 3]
+        if max(ax, bx) < xmin or min(ax, bx) > xmax or max(ay, by) < ymin or min(ay, by) > ymax:
+            continue
+        if _inside(poly, ax, ay) or _inside(poly, bx, by):
+            return True
+        for e in range(k):
+            f = (e + 1) % k
+            if _segments_intersect(ax, ay, bx, by, poly[e, 0], poly[e, 1], poly[f, 0], poly[f, 1]):
+                return True
+    for i in range(circles.shape[0]):
+        cx, cy, r = circles[i, 0], circles[i, 1], circles[i, 2]
+        if cx + r < xmin or cx - r > xmax or cy + r < ymin or cy - r > ymax:
+            continue
+        if _inside(poly, cx, cy):
+            return True
+        r2 = r * r
+        for e in range(k):
+            f = (e + 1) % k
+            if _point_segment_dist2(cx, cy, poly[e, 0], poly[e, 1], poly[f, 0], poly[f, 1]) < r2:
+                return True
+    return False
+
+
+def circle_polygon(radius: float, sides: int = 24) -> F64:
+    """A polygon circumscribing a circle (so the polygon test never misses a contact)."""
+    r = radius / math.cos(math.pi / sides)
+    a = np.arange(sides) * (2 * math.pi / sides)
+    return np.stack([r * np.cos(a), r * np.sin(a)], axis=1)
+
+
+class Obstacles:
+    """The parts of a scene that a robot of a given height band can bump into.
+
+    Args:
+        scene: the world's scene.
+        z_min, z_max: the robot body's height band above the floor; walls entirely below
+            ``z_min`` (a floor mat) or above ``z_max`` (a table top) do not block it.
+    """
+
+    def __init__(self, scene: Scene, *, z_min: float = 0.02, z_max: float = 2.0) -> None:
+        seg_keep = (scene.segment_z[:, 1] > z_min) & (scene.segment_z[:, 0] < z_max)
+        circ_keep = (scene.circle_z[:, 1] > z_min) & (scene.circle_z[:, 0] < z_max)
+        self.segments = np.ascontiguousarray(scene.segments[seg_keep])
+        self.circles = np.ascontiguousarray(scene.circles[circ_keep])
+
+    def hits(self, footprint: F64, x: float, y: float, theta: float) -> bool:
+        """True if the body-frame ``footprint`` polygon at pose (x, y, theta) touches."""
+        c, s = math.cos(theta), math.sin(theta)
+        world = footprint @ np.array([[c, s], [-s, c]]) + np.array([x, y])
+        return bool(polygon_hits(np.ascontiguousarray(world), self.segments, self.circles))
+
+    def move(
+        self,
+        footprint: F64,
+        start: tuple[float, float, float],
+        goal: tuple[float, float, float],
+        iterations: int = 8,
+    ) -> tuple[tuple[float, float, float], bool]:
+        """Move from ``start`` towards ``goal`` as far as the footprint stays clear.
+
+        Long moves are checked in sub-steps no longer than half the footprint's inner
+        radius, so nothing tunnels through a thin wall. Returns the reached pose and
+        whether a contact stopped the motion. Rotation and translation are tried
+        separately, so a robot against a wall can still turn away from it.
+        """
+        x0, y0, th0 = start
+        x1, y1, th1 = goal
+        dist = math.hypot(x1 - x0, y1 - y0)
+        inner = _inner_radius(footprint)
+        n = max(1, math.ceil(dist / (0.5 * inner))) if inner > 0 else 1
+        dth = float(wrap_angle(th1 - th0))
+        for k in range(1, n + 1):
+            f = k / n
+            pose = (x0 + f * (x1 - x0), y0 + f * (y1 - y0), float(wrap_angle(th0 + f * dth)))
+            if self.hits(footprint, *pose):
+                prev = (x0 + (f - 1 / n) * (x1 - x0), y0 + (f - 1 / n) * (y1 - y0))
+                return self._contact(footprint, prev, pose, th0, iterations), True
+        return goal, False
+
+    def _contact(
+        self,
+        footprint: F64,
+        prev: tuple[float, float],
+        blocked: tuple[float, float, float],
+        th0: float,
+        iterations: int,
+    ) -> tuple[float, float, float]:
+        px, py = prev
+        bx, by, bth = blocked
+        th = bth if not self.hits(footprint, px, py, bth) else th0
+        lo, hi = 0.0, 1.0
+        for _ in range(iterations):
+            mid = 0.5 * (lo + hi)
+            if self.hits(footprint, px + mid * (bx - px), py + mid * (by - py), th):
+                hi = mid
+            else:
+                lo = mid
+        return (px + lo * (bx - px), py + lo * (by - py), th)
+
+
+def _inner_radius(footprint: F64) -> float:
+    """Distance from the body origin to the nearest footprint edge."""
+    best = math.inf
+    k = len(footprint)
+    for i in range(k):
+        a, b = footprint[i], footprint[(i + 1) % k]
+        d = b - a
+        ll = float(d @ d)
+        t = 0.0 if ll == 0 else min(1.0, max(0.0, float(-a @ d) / ll))
+        c = a + t * d
+        best = min(best, math.hypot(float(c[0]), float(c[1])))
+    return best
