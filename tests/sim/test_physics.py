@@ -83,9 +83,10 @@ def test_polygon_hits_walls_and_circles() -> None:
     scene = _room()
     box = np.array([[-0.1, -0.1], [0.1, -0.1], [0.1, 0.1], [-0.1, 0.1]])
     assert not polygon_hits(box, scene.segments[:4], scene.circles)
-    assert polygon_hits(box + [1.95, 0.0], scene.segments[:4], scene.circles)
-    assert polygon_hits(box + [1.0, -0.75], scene.segments[:4], scene.circles)  # pillar edge
-    assert not polygon_hits(box + [1.0, -0.65], scene.segments[:4], scene.circles)
+    assert polygon_hits(box + np.array([1.95, 0.0]), scene.segments[:4], scene.circles)
+    # the pillar edge
+    assert polygon_hits(box + np.array([1.0, -0.75]), scene.segments[:4], scene.circles)
+    assert not polygon_hits(box + np.array([1.0, -0.65]), scene.segments[:4], scene.circles)
     big = box * 30  # a wall entirely inside the polygon still counts
     assert polygon_hits(big, scene.segments[:4], scene.circles)
 
