@@ -89,7 +89,9 @@ class McapRecorder:
             self._record(pub.topic.name, pub.topic.typename)
 
     def on_subscription(self, sub: Subscription, added: bool) -> None:
-        pass
+        # a topic only subscribed here still carries messages from other processes
+        if added and sub.node is not self._node:
+            self._record(sub.topic.name, sub.topic.typename)
 
     def close(self) -> None:
         if self._fh is None:

@@ -6,6 +6,8 @@ import time
 from dataclasses import dataclass, replace
 from typing import Any
 
+import typer
+
 from roverlab.core import Context
 from roverlab.core.transport.daemon import ensure_daemon
 from roverlab.core.transport.zenoh import (
@@ -15,7 +17,7 @@ from roverlab.core.transport.zenoh import (
     query_graph,
 )
 
-__all__ = ["Connection", "NetworkOptions", "wait_for_graph"]
+__all__ = ["Connection", "NetworkOptions", "network_options", "run_context"]
 
 _SETTLE_S = 0.3
 
@@ -78,15 +80,23 @@ class Connection:
         self.close()
 
 
-def wait_for_graph(
-    conn: Connection, predicate: Any, timeout_s: float | None, poll_s: float = 0.2
-) -> list[GraphEntity]:
-    """Poll the graph until ``predicate(entities)`` holds or the timeout passes."""
-    deadline = None if timeout_s is None else time.monotonic() + timeout_s
-    while True:
-        ents = conn.graph(timeout_s=0.5)
-        if predicate(ents):
-            return ents
-        if deadline is not None and time.monotonic() >= deadline:
-            return ents
-        time.sleep(poll_s)
+def network_options(ctx: typer.Context) -> NetworkOptions:
+    """The root command's connection options (``roverlab --connect ... CMD``)."""
+    obj = ctx.find_root().obj
+    return obj if isinstance(obj, NetworkOptions) else NetworkOptions()
+
+
+def run_context(context: Context, duration_s: float | None) -> float:
+    """Spin until ``duration_s`` of clock time (or forever), Ctrl-C, or shutdown; then
+    shut the context down. Returns the wall seconds it ran."""
+    started = time.monotonic()
+    try:
+        if duration_s is None:
+            context.spin()
+        else:
+            context.spin_for(duration_s)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        context.shutdown()
+    return time.monotonic() - started

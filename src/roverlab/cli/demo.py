@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-import time
 from typing import Annotated
 
 import typer
 
-from roverlab.cli.common import NetworkOptions
+from roverlab.cli.common import network_options, run_context
 from roverlab.core import Context, configure_logging
 from roverlab.core.transport.zenoh import ZenohTransport
 from roverlab.demo import DemoRobot, Talker
@@ -37,9 +36,7 @@ def demo(
     DemoRobot(context=context)
     Talker(context=context)
     if expose:
-        obj = ctx.find_root().obj
-        options = obj if isinstance(obj, NetworkOptions) else NetworkOptions()
-        context.add_transport(ZenohTransport(options.zenoh_options()))
+        context.add_transport(ZenohTransport(network_options(ctx).zenoh_options()))
     typer.echo(
         "roverlab demo running. In another terminal try:\n"
         "  roverlab topic list\n"
@@ -50,14 +47,5 @@ def demo(
         "Ctrl-C to stop.",
         err=True,
     )
-    started = time.monotonic()
-    try:
-        if duration is None:
-            context.spin()
-        else:
-            context.spin_for(duration)
-    except KeyboardInterrupt:
-        pass
-    finally:
-        context.shutdown()
-    typer.echo(f"demo stopped after {time.monotonic() - started:.1f} s", err=True)
+    wall = run_context(context, duration)
+    typer.echo(f"demo stopped after {wall:.1f} s", err=True)

@@ -7,7 +7,7 @@ from typing import Annotated, Any
 import typer
 import yaml
 
-from roverlab.cli.common import Connection, NetworkOptions
+from roverlab.cli.common import Connection, network_options
 from roverlab.core.errors import ParameterError
 from roverlab.core.transport.zenoh import query_parameters
 
@@ -17,15 +17,10 @@ param_app = typer.Typer(
 )
 
 
-def _options(ctx: typer.Context) -> NetworkOptions:
-    obj = ctx.find_root().obj
-    return obj if isinstance(obj, NetworkOptions) else NetworkOptions()
-
-
 @node_app.command("list")
 def node_list(ctx: typer.Context) -> None:
     """List the nodes of every running roverlab process."""
-    with Connection(_options(ctx)) as conn:
+    with Connection(network_options(ctx)) as conn:
         names = sorted({e.node for e in conn.graph() if e.kind == "node"})
     for name in names:
         typer.echo(name)
@@ -37,7 +32,7 @@ def node_info(
 ) -> None:
     """Print a node's publishers and subscriptions."""
     fq = node if node.startswith("/") else "/" + node
-    with Connection(_options(ctx)) as conn:
+    with Connection(network_options(ctx)) as conn:
         ents = [e for e in conn.graph() if e.node == fq]
     if not ents:
         raise ParameterError(f"node '{fq}' not found (is it running?)")
@@ -49,7 +44,7 @@ def node_info(
 
 
 def _ask(ctx: typer.Context, node: str, request: dict[str, Any]) -> dict[str, Any]:
-    with Connection(_options(ctx)) as conn:
+    with Connection(network_options(ctx)) as conn:
         answer = query_parameters(conn.transport.session, node, request, conn.transport.domain)
     if "error" in answer:
         raise ParameterError(str(answer["error"]))

@@ -7,8 +7,9 @@ from typing import Annotated
 
 import typer
 
-from roverlab.cli import daemon, demo, graph, tf, topic
+from roverlab.cli import daemon, demo, graph, sim, tf, topic
 from roverlab.cli.common import NetworkOptions
+from roverlab.description import cli as urdf_cli
 from roverlab.errors import RoverlabError
 from roverlab.teleop import cli as teleop_cli
 
@@ -25,6 +26,8 @@ app.add_typer(graph.param_app, name="param")
 app.add_typer(tf.app, name="tf")
 app.add_typer(daemon.app, name="daemon")
 app.command("demo")(demo.demo)
+app.command("sim")(sim.sim)
+app.add_typer(urdf_cli.app, name="urdf")
 app.command("teleop")(teleop_cli.teleop)
 
 

@@ -7,16 +7,11 @@ from typing import Annotated
 
 import typer
 
-from roverlab.cli.common import Connection, NetworkOptions
+from roverlab.cli.common import Connection, network_options
 from roverlab.core import Time
 from roverlab.tf import Buffer, TransformException, TransformListener, format_transform_echo
 
 app = typer.Typer(help="Inspect transforms (tf2_echo, view_frames).", no_args_is_help=True)
-
-
-def _options(ctx: typer.Context) -> NetworkOptions:
-    obj = ctx.find_root().obj
-    return obj if isinstance(obj, NetworkOptions) else NetworkOptions()
 
 
 @app.command("echo")
@@ -36,7 +31,7 @@ def echo(
     """Print the transform from SOURCE_FRAME to TARGET_FRAME, as tf2_echo."""
     if not rate > 0:
         raise typer.BadParameter("rate must be > 0", param_hint="--rate")
-    with Connection(_options(ctx)) as conn:
+    with Connection(network_options(ctx)) as conn:
         buffer = Buffer()
         node = conn.context.create_node("roverlab_tf_echo")
         TransformListener(buffer, node)
@@ -73,7 +68,7 @@ def frames(
     wait: Annotated[float, typer.Option("--wait", help="Seconds to listen before printing.")] = 2.0,
 ) -> None:
     """Listen for a while, then print the TF tree as text (like view_frames)."""
-    with Connection(_options(ctx)) as conn:
+    with Connection(network_options(ctx)) as conn:
         buffer = Buffer()
         node = conn.context.create_node("roverlab_view_frames")
         TransformListener(buffer, node)

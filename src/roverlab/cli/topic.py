@@ -11,7 +11,7 @@ import numpy as np
 import typer
 import yaml
 
-from roverlab.cli.common import Connection, NetworkOptions
+from roverlab.cli.common import Connection, network_options
 from roverlab.core import QoSProfile
 from roverlab.core.errors import GraphError
 from roverlab.core.graph import resolve_name
@@ -19,11 +19,6 @@ from roverlab.core.transport.zenoh import GraphEntity
 from roverlab.msgs import normalize_type_name, parse_yaml_message, to_dict, to_yaml
 
 app = typer.Typer(help="Inspect and publish topics (rostopic / ros2 topic).", no_args_is_help=True)
-
-
-def _options(ctx: typer.Context) -> NetworkOptions:
-    obj = ctx.find_root().obj
-    return obj if isinstance(obj, NetworkOptions) else NetworkOptions()
 
 
 def _topic_types(ents: list[GraphEntity]) -> dict[str, set[str]]:
@@ -45,7 +40,7 @@ def list_topics(
     ] = False,
 ) -> None:
     """List the topics of every running roverlab process."""
-    with Connection(_options(ctx)) as conn:
+    with Connection(network_options(ctx)) as conn:
         ents = conn.graph()
     types = _topic_types(ents)
     if verbose:
@@ -78,7 +73,7 @@ def info(
 ) -> None:
     """Print a topic's type and its publishers and subscriptions."""
     name = resolve_name(topic)
-    with Connection(_options(ctx)) as conn:
+    with Connection(network_options(ctx)) as conn:
         ents = [e for e in conn.graph() if e.topic == name]
     if not ents:
         raise GraphError(f"unknown topic '{name}' (no process publishes or subscribes to it)")
@@ -149,7 +144,7 @@ def echo(
     name = resolve_name(topic)
     tname = normalize_type_name(msg_type) if msg_type else None
     limit = 1 if once else count
-    with Connection(_options(ctx)) as conn:
+    with Connection(network_options(ctx)) as conn:
         if tname is None:
             tname = _discover_type(conn, name, timeout)
         node = conn.context.create_node("roverlab_topic_echo")
@@ -212,7 +207,7 @@ def pub(
     tname = normalize_type_name(msg_type)
     msg = parse_yaml_message(tname, values)  # validate before touching the network
     limit = 1 if once else times
-    with Connection(_options(ctx)) as conn:
+    with Connection(network_options(ctx)) as conn:
         node = conn.context.create_node("roverlab_topic_pub")
         publisher = node.create_publisher(tname, name, 10)
         if limit is not None:
@@ -254,7 +249,7 @@ def hz(
 ) -> None:
     """Print the publishing rate of a topic every second, as rostopic hz."""
     name = resolve_name(topic)
-    with Connection(_options(ctx)) as conn:
+    with Connection(network_options(ctx)) as conn:
         tname = normalize_type_name(msg_type) if msg_type else _discover_type(conn, name, None)
         node = conn.context.create_node("roverlab_topic_hz")
         stamps: list[float] = []

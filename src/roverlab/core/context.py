@@ -14,7 +14,7 @@ from roverlab.core.log import NodeLogger
 from roverlab.core.node import Node, Publisher, Subscription
 from roverlab.core.qos import QoSProfile
 from roverlab.core.time import Duration, Time
-from roverlab.msgs import Clock as ClockMsg
+from roverlab.msgs import classes as mc
 
 __all__ = ["Context", "Transport"]
 
@@ -95,11 +95,12 @@ class Context:
 
     def _start_clock_publisher(self) -> None:
         node = Node("clock_publisher", context=self)
-        pub = node.create_publisher(ClockMsg, "/clock", 10)
+        pub = node.create_publisher(mc.Clock, "/clock", 10)
         ex = self.executor
 
         def tick() -> None:
-            pub.publish(ClockMsg(clock=Time(ex.now_ns).to_msg()))
+            if pub.has_listeners:  # nobody listening here or elsewhere: nothing to build
+                pub.publish(mc.Clock(clock=Time(ex.now_ns).to_msg()))
 
         node.create_timer(self._clock_period_s, tick)
         self._clock_node = node
@@ -111,7 +112,7 @@ class Context:
         def on_clock(msg: Any) -> None:
             ex.set_external_time(Time.from_msg(msg.clock).nanoseconds)
 
-        node.create_subscription(ClockMsg, "/clock", on_clock, QoSProfile(depth=1))
+        node.create_subscription(mc.Clock, "/clock", on_clock, QoSProfile(depth=1))
 
     # ----------------------------------------------------------------- nodes
     def create_node(self, node_name: str, **kwargs: Any) -> Node:

@@ -84,6 +84,15 @@ class Publisher:
     def get_subscription_count(self) -> int:
         return len(self.topic.subscriptions)
 
+    @property
+    def has_listeners(self) -> bool:
+        """Whether anyone (here or in another process) would receive a message now.
+
+        Publishers of expensive or optional data check it to skip building messages
+        nobody reads, as Gazebo's ROS plugins do.
+        """
+        return bool(self.topic.subscriptions) or self.topic.remote_send is not None
+
     def destroy(self) -> None:
         self.node.destroy_publisher(self)
 

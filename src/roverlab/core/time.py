@@ -6,8 +6,7 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-from roverlab.msgs import Duration as DurationMsg
-from roverlab.msgs import Time as TimeMsg
+from roverlab.msgs import classes as mc
 
 __all__ = ["Duration", "Time"]
 
@@ -32,7 +31,7 @@ class Duration:
 
     def to_msg(self) -> Any:
         sec, nsec = divmod(self.nanoseconds, _NS)
-        return DurationMsg(sec=sec, nanosec=nsec)
+        return mc.Duration(sec=sec, nanosec=nsec)
 
     def __add__(self, other: Duration) -> Duration:
         return Duration(self.nanoseconds + other.nanoseconds)
@@ -71,7 +70,7 @@ class Time:
 
     def to_msg(self) -> Any:
         sec, nsec = divmod(self.nanoseconds, _NS)
-        return TimeMsg(sec=sec, nanosec=nsec)
+        return mc.Time(sec=sec, nanosec=nsec)
 
     def __add__(self, other: Duration) -> Time:
         return Time(self.nanoseconds + other.nanoseconds)

@@ -181,14 +181,27 @@ class Transform3:
         return Transform3((float(t[0]), float(t[1]), float(t[2])), _q4(q))
 
     def __mul__(self, other: Transform3) -> Transform3:
-        t = np.asarray(self.translation) + quat_rotate(self.rotation, other.translation)
-        q = quat_multiply(self.rotation, other.rotation)
-        return Transform3.from_arrays(t, q)
+        # plain float arithmetic: this sits on every TF and robot_state_publisher path,
+        # where numpy's per-call overhead on 3- and 4-vectors dominates
+        ax, ay, az, aw = self.rotation
+        bx, by, bz, bw = other.rotation
+        tx, ty, tz = _rotate(self.rotation, other.translation)
+        sx, sy, sz = self.translation
+        return Transform3(
+            (sx + tx, sy + ty, sz + tz),
+            (
+                aw * bx + ax * bw + ay * bz - az * by,
+                aw * by - ax * bz + ay * bw + az * bx,
+                aw * bz + ax * by - ay * bx + az * bw,
+                aw * bw - ax * bx - ay * by - az * bz,
+            ),
+        )
 
     def __invert__(self) -> Transform3:
-        qi = quat_conjugate(self.rotation)
-        t = -quat_rotate(qi, self.translation)
-        return Transform3.from_arrays(t, qi)
+        x, y, z, w = self.rotation
+        qi = (-x, -y, -z, w)
+        tx, ty, tz = _rotate(qi, self.translation)
+        return Transform3((-tx, -ty, -tz), qi)
 
     def apply(self, points: ArrayLike) -> FloatArray:
         """Transform (3,) or (N, 3) points from the child frame into the parent frame."""
@@ -210,6 +223,23 @@ class Transform3:
         a = np.asarray(self.translation)
         b = np.asarray(other.translation)
         return Transform3.from_arrays(a + t * (b - a), quat_slerp(self.rotation, other.rotation, t))
+
+
+def _rotate(
+    q: tuple[float, float, float, float], v: tuple[float, float, float]
+) -> tuple[float, float, float]:
+    """Rotate vector ``v`` by unit quaternion ``q`` (floats, no numpy)."""
+    qx, qy, qz, qw = q
+    vx, vy, vz = v
+    # t = 2 * cross(q.xyz, v); v' = v + w * t + cross(q.xyz, t)
+    tx = 2.0 * (qy * vz - qz * vy)
+    ty = 2.0 * (qz * vx - qx * vz)
+    tz = 2.0 * (qx * vy - qy * vx)
+    return (
+        vx + qw * tx + (qy * tz - qz * ty),
+        vy + qw * ty + (qz * tx - qx * tz),
+        vz + qw * tz + (qx * ty - qy * tx),
+    )
 
 
 def _q4(q: FloatArray) -> tuple[float, float, float, float]:

@@ -8,10 +8,9 @@ import numba
 import numpy as np
 from numpy.typing import NDArray
 
-from roverlab.geometry import wrap_angle
 from roverlab.raycast.scene import Scene
 
-__all__ = ["Obstacles", "circle_polygon", "polygon_hits"]
+__all__ = ["Obstacles", "circle_polygon", "inner_radius", "polygon_hits"]
 
 F64 = NDArray[np.float64]
 
@@ -131,56 +130,8 @@ class Obstacles:
         world = footprint @ np.array([[c, s], [-s, c]]) + np.array([x, y])
         return bool(polygon_hits(np.ascontiguousarray(world), self.segments, self.circles))
 
-    def move(
-        self,
-        footprint: F64,
-        start: tuple[float, float, float],
-        goal: tuple[float, float, float],
-        iterations: int = 8,
-    ) -> tuple[tuple[float, float, float], bool]:
-        """Move from ``start`` towards ``goal`` as far as the footprint stays clear.
 
-        Long moves are checked in sub-steps no longer than half the footprint's inner
-        radius, so nothing tunnels through a thin wall. Returns the reached pose and
-        whether a contact stopped the motion. Rotation and translation are tried
-        separately, so a robot against a wall can still turn away from it.
-        """
-        x0, y0, th0 = start
-        x1, y1, th1 = goal
-        dist = math.hypot(x1 - x0, y1 - y0)
-        inner = _inner_radius(footprint)
-        n = max(1, math.ceil(dist / (0.5 * inner))) if inner > 0 else 1
-        dth = float(wrap_angle(th1 - th0))
-        for k in range(1, n + 1):
-            f = k / n
-            pose = (x0 + f * (x1 - x0), y0 + f * (y1 - y0), float(wrap_angle(th0 + f * dth)))
-            if self.hits(footprint, *pose):
-                prev = (x0 + (f - 1 / n) * (x1 - x0), y0 + (f - 1 / n) * (y1 - y0))
-                return self._contact(footprint, prev, pose, th0, iterations), True
-        return goal, False
-
-    def _contact(
-        self,
-        footprint: F64,
-        prev: tuple[float, float],
-        blocked: tuple[float, float, float],
-        th0: float,
-        iterations: int,
-    ) -> tuple[float, float, float]:
-        px, py = prev
-        bx, by, bth = blocked
-        th = bth if not self.hits(footprint, px, py, bth) else th0
-        lo, hi = 0.0, 1.0
-        for _ in range(iterations):
-            mid = 0.5 * (lo + hi)
-            if self.hits(footprint, px + mid * (bx - px), py + mid * (by - py), th):
-                hi = mid
-            else:
-                lo = mid
-        return (px + lo * (bx - px), py + lo * (by - py), th)
-
-
-def _inner_radius(footprint: F64) -> float:
+def inner_radius(footprint: F64) -> float:
     """Distance from the body origin to the nearest footprint edge."""
     best = math.inf
     k = len(footprint)

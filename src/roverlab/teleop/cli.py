@@ -27,7 +27,7 @@ from typing import Annotated, Any, Final
 import typer
 import yaml
 
-from roverlab.cli.common import Connection, NetworkOptions
+from roverlab.cli.common import Connection, network_options
 from roverlab.core.graph import resolve_name, validate_node_name
 from roverlab.errors import RoverlabError
 from roverlab.teleop.errors import TeleopError
@@ -120,11 +120,6 @@ def parse_ros_args(
     return TeleopArgs(parameters, remappings, node_name, namespace)
 
 
-def _options(ctx: typer.Context) -> NetworkOptions:
-    obj = ctx.find_root().obj
-    return obj if isinstance(obj, NetworkOptions) else NetworkOptions()
-
-
 def _print(line: str) -> None:
     sys.stdout.write(line + "\n")
     sys.stdout.flush()
@@ -186,7 +181,7 @@ def teleop(
         parameters[pname] = checked
     fd = stdin_fd()  # fail before touching the network when there is no keyboard
     code = 0
-    with Connection(_options(ctx)) as conn:
+    with Connection(network_options(ctx)) as conn:
         node = node_class(
             context=conn.context,
             node_name=parsed.node_name,

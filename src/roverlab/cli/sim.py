@@ -1,0 +1,133 @@
+"""``roverlab sim``: Gazebo + spawn_model + robot_state_publisher in one command."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from roverlab.bag import McapRecorder
+from roverlab.cli.common import network_options, run_context
+from roverlab.core import Context, configure_logging
+from roverlab.core.transport.zenoh import ZenohTransport
+from roverlab.sim.app import Simulation, SimulationError
+from roverlab.sim.node import SpawnPose
+
+
+def parse_rate(text: str) -> float:
+    """``max`` (as fast as the CPU allows) or a positive real-time factor."""
+    if text.strip().lower() == "max":
+        return math.inf
+    try:
+        rate = float(text)
+    except ValueError:
+        raise SimulationError(f"--rate must be a positive number or 'max', got {text!r}") from None
+    if not (rate > 0 and math.isfinite(rate)):
+        raise SimulationError(f"--rate must be a positive number or 'max', got {text!r}")
+    return rate
+
+
+def parse_args(items: list[str] | None) -> dict[str, str]:
+    """xacro arguments ``name:=value``."""
+    out: dict[str, str] = {}
+    for item in items or []:
+        name, sep, value = item.partition(":=")
+        if not sep or not name:
+            raise SimulationError(f"--arg expects name:=value, got {item!r}")
+        out[name] = value
+    return out
+
+
+def sim(
+    ctx: typer.Context,
+    world: Annotated[
+        str,
+        typer.Option(
+            "--world",
+            "-w",
+            help="Bundled world (maze, office, house, empty) or a .world/.sdf/.yaml file.",
+        ),
+    ] = "maze",
+    robot: Annotated[
+        str,
+        typer.Option(
+            "--robot", "-r", help="Bundled robot (mbot, mybot, mycar) or a URDF/xacro file."
+        ),
+    ] = "mybot",
+    x: Annotated[float, typer.Option("-x", help="Spawn x (m), as spawn_model -x.")] = 0.0,
+    y: Annotated[float, typer.Option("-y", help="Spawn y (m), as spawn_model -y.")] = 0.0,
+    yaw: Annotated[
+        float, typer.Option("-Y", "--yaw", help="Spawn yaw (rad), as spawn_model -Y.")
+    ] = 0.0,
+    seed: Annotated[int, typer.Option("--seed", help="Seed of every random draw.")] = 0,
+    rate: Annotated[
+        str,
+        typer.Option(
+            "--rate",
+            help="Sim seconds per wall second: 1 = real time, 'max' = as fast as possible.",
+        ),
+    ] = "1",
+    duration: Annotated[
+        float | None, typer.Option("--duration", help="Stop after this many sim seconds.")
+    ] = None,
+    record: Annotated[
+        Path | None,
+        typer.Option("--record", help="Record every topic to this MCAP file (ROS 2 CDR)."),
+    ] = None,
+    arg: Annotated[
+        list[str] | None,
+        typer.Option("--arg", help="xacro argument name:=value (repeatable)."),
+    ] = None,
+    expose: Annotated[
+        bool,
+        typer.Option(
+            "--expose/--no-expose",
+            help="Make the topics visible to other processes (roverlab topic echo, teleop).",
+        ),
+    ] = True,
+) -> None:
+    """Simulate a robot in a world: /cmd_vel in; /odom, /tf, /scan, /imu, cameras, /clock out."""
+    pace = parse_rate(rate)
+    if duration is not None and not (duration > 0 and math.isfinite(duration)):
+        raise SimulationError(f"--duration must be a positive number of seconds, got {duration}")
+    configure_logging()
+    context = Context(
+        clock="sim" if math.isinf(pace) else "paced", rate=1.0 if math.isinf(pace) else pace
+    )
+    recorder: McapRecorder | None = None
+    try:
+        if record is not None:
+            recorder = McapRecorder(record)
+            context.add_transport(recorder)
+        simulation = Simulation(
+            context=context,
+            world=world,
+            robot=robot,
+            spawn=SpawnPose(x, y, yaw),
+            seed=seed,
+            robot_args=parse_args(arg),
+        )
+        if expose:
+            context.add_transport(ZenohTransport(network_options(ctx).zenoh_options()))
+    except BaseException:
+        if recorder is not None:
+            recorder.abort()
+        context.shutdown()
+        raise
+    cfg = simulation.config
+    sensors = [s.topic for s in cfg.lidars] + [s.topic for s in cfg.imus]
+    sensors += [c.image_topic for c in cfg.cameras] + [d.points_topic for d in cfg.depth_cameras]
+    typer.echo(
+        f"simulating {simulation.robot_model.name} in {simulation.world_model.name} "
+        f"(rate {rate}, seed {seed}); sensors: {', '.join(sensors) or 'none'}",
+        err=True,
+    )
+    wall = run_context(context, duration)
+    sim_s = context.now().seconds
+    typer.echo(
+        f"simulated {sim_s:.1f} s in {wall:.1f} s wall ({sim_s / max(wall, 1e-9):.1f}x real time)"
+        + (f"; recorded {recorder.messages} messages to {record}" if recorder else ""),
+        err=True,
+    )

@@ -1,0 +1,133 @@
+"""``check_urdf``'s report of a robot, plus what its ``<gazebo>`` tags declare.
+
+The first part is byte for byte what urdfdom's ``check_urdf`` prints (children in the
+order urdfdom keeps them: by joint name)::
+
+    robot name is: mybot
+    ---------- Successfully Parsed XML ---------------
+    root Link: base_footprint has 1 child(ren)
+        child(1):  base_link
+            child(1):  ball_wheel_link
+            ...
+
+then the sensors and plugins, each marked supported or not by roverlab.
+"""
+
+from __future__ import annotations
+
+import math
+
+from roverlab.description.gazebo import (
+    CameraPluginSpec,
+    DiffDriveSpec,
+    GazeboPlugin,
+    GazeboSensor,
+    ImuPluginSpec,
+    KinectPluginSpec,
+    LaserPluginSpec,
+)
+from roverlab.description.model import RobotModel
+
+__all__ = ["format_check", "format_tree"]
+
+
+def format_tree(model: RobotModel) -> str:
+    """The ``check_urdf`` part: robot name, banner, root link and the indented tree."""
+    root = model.root_link
+    lines = [
+        f"robot name is: {model.name}",
+        "---------- Successfully Parsed XML ---------------",
+        f"root Link: {root} has {len(model.child_joints(root))} child(ren)",
+    ]
+
+    def walk(link: str, level: int) -> None:
+        level += 2
+        joints = sorted(model.child_joints(link), key=lambda j: j.name)
+        for count, j in enumerate(joints, start=1):
+            lines.append("  " * level + f"child({count}):  {j.child}")
+            walk(j.child, level)
+
+    walk(root, 0)
+    return "\n".join(lines)
+
+
+def _num(value: float) -> str:
+    return f"{value:g}"
+
+
+def _sensor_line(s: GazeboSensor) -> str:
+    head = f"  {s.name} ({s.type}) on {s.reference_link}"
+    rate = f", {_num(s.update_rate_hz)} Hz" if s.update_rate_hz else ""
+    if s.ray is not None:
+        r = s.ray
+        detail = (
+            f": {r.samples} samples over [{r.min_angle:.4f}, {r.max_angle:.4f}] rad, "
+            f"range {_num(r.range_min)}-{_num(r.range_max)} m"
+        )
+        if r.vertical is not None:
+            detail += f", {r.vertical.samples} vertical samples"
+    elif s.camera is not None:
+        c = s.camera
+        detail = (
+            f": {c.width}x{c.height} {c.format}, hfov {c.horizontal_fov:.6g} rad "
+            f"({math.degrees(c.horizontal_fov):.1f} deg), clip {_num(c.clip_near)}-"
+            f"{_num(c.clip_far)} m"
+        )
+    elif s.imu is not None:
+        detail = f": rate noise {_num(s.imu.rate.stddev)}, accel noise {_num(s.imu.accel.stddev)}"
+    else:
+        detail = ": not supported by roverlab"
+    return head + detail + rate
+
+
+def _plugin_line(p: GazeboPlugin) -> str:
+    owner = f"sensor '{p.reference}'" if p.reference is not None else "model"
+    head = f"  {p.name or '(unnamed)'} [{p.filename}] on {owner}"
+    spec = p.spec
+    if isinstance(spec, DiffDriveSpec):
+        detail = (
+            f": {spec.left_joint}/{spec.right_joint}, separation "
+            f"{_num(spec.wheel_separation_m)} m, diameter {_num(spec.wheel_diameter_m)} m, "
+            f"{spec.command_topic} -> {spec.odometry_topic} "
+            f"({spec.odometry_frame} -> {spec.robot_base_frame})"
+        )
+    elif isinstance(spec, LaserPluginSpec):
+        detail = f": {spec.topic} in frame {spec.frame_id}"
+    elif isinstance(spec, CameraPluginSpec):
+        detail = f": {spec.image_topic}, {spec.camera_info_topic} in frame {spec.frame_id}"
+    elif isinstance(spec, KinectPluginSpec):
+        detail = (
+            f": {spec.image_topic}, {spec.depth_image_topic}, {spec.point_cloud_topic} "
+            f"in frame {spec.frame_id}"
+        )
+    elif isinstance(spec, ImuPluginSpec):
+        detail = f": {spec.topic} from link {spec.body_name} in frame {spec.frame_id}"
+    else:
+        detail = ": not supported by roverlab (ignored)"
+    return head + detail
+
+
+def format_check(model: RobotModel) -> str:
+    """The ``check_urdf`` report followed by the robot's Gazebo sensors and plugins.
+
+    Returns:
+        Text without a trailing newline.
+    """
+    lines = [format_tree(model)]
+    sensors = model.gazebo.sensors
+    plugins = model.gazebo.plugins
+    lines.append(f"---------- Gazebo sensors: {len(sensors)} ---------------")
+    lines.extend(_sensor_line(s) for s in sensors)
+    lines.append(f"---------- Gazebo plugins: {len(plugins)} ---------------")
+    lines.extend(_plugin_line(p) for p in plugins)
+    unsupported = [f"plugin {p.filename}" for p in model.gazebo.unsupported_plugins]
+    unsupported += [f"sensor type {s.type}" for s in model.gazebo.unsupported_sensors]
+    unknown = [r for r in model.gazebo.references if r not in model.links and r not in model.joints]
+    if unsupported:
+        lines.append("unsupported (ignored): " + ", ".join(dict.fromkeys(unsupported)))
+    if unknown:
+        lines.append(
+            "warning: <gazebo reference> names no link or joint: "
+            + ", ".join(f"'{r}'" for r in unknown)
+        )
+    return "\n".join(lines)

@@ -1,0 +1,248 @@
+"""``robot_state_publisher`` and ``joint_state_publisher`` nodes.
+
+Both take the robot from the ``robot_description`` keyword (URDF/xacro XML, a file path or
+a :class:`RobotModel`) or, as ROS 2's nodes do, from their ``robot_description`` parameter
+(e.g. set by a launch file from ``xacro``). The tree math is :class:`RobotModel`'s; these
+classes only turn messages into joint positions and transforms into messages.
+
+RobotStatePublisher (ROS names and semantics)
+    * publishes the fixed (and planar) joints once on ``/tf_static`` (latched);
+    * on every ``/joint_states`` message, publishes the movable joints it names (and the
+      joints mimicking them) on ``/tf``, stamped with the message's stamp, at most
+      ``publish_frequency`` times per second per joint (as ROS 1's JointStateListener);
+      ``ignore_timestamp`` publishes every message, stamped now (as does a zero stamp);
+    * prefixes frames with ``frame_prefix`` (ROS 2);
+    * latches the URDF on ``/robot_description`` (std_msgs/String), as ROS 2 does.
+
+JointStatePublisher
+    publishes ``/joint_states`` for every movable joint at ``rate`` Hz: 0 (or the middle of
+    the limits when they exclude 0), overridden by the latest values from the
+    ``source_list`` topics; mimic joints follow their joint.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+from roverlab.core import Context, Duration, Node, ParameterError, QoSProfile, Time
+from roverlab.description.errors import DescriptionError
+from roverlab.description.model import Joint, JointType, RobotModel
+from roverlab.description.urdf import load_robot
+from roverlab.msgs import Header, JointState, String
+from roverlab.msgs import classes as mc
+from roverlab.tf import StaticTransformBroadcaster, TransformBroadcaster, transform_to_msg
+
+__all__ = ["JointStatePublisher", "RobotStatePublisher"]
+
+_LATCHED = QoSProfile(depth=1, durability="transient_local")
+
+
+def _robot(node: Node, robot_description: str | RobotModel | None) -> RobotModel:
+    """The robot from the keyword, else from the ``robot_description`` parameter."""
+    initial = robot_description.urdf if isinstance(robot_description, RobotModel) else ""
+    param = node.declare_parameter("robot_description", initial)
+    if isinstance(robot_description, RobotModel):
+        return robot_description
+    source = robot_description if robot_description is not None else str(param.value)
+    if not source.strip():
+        raise DescriptionError(
+            f"{node.get_name()}: no robot description (pass robot_description= or set "
+            f"the robot_description parameter)"
+        )
+    model = load_robot(source)
+    param.value = model.urdf  # the expanded URDF, as a launch file's xacro command sets it
+    return model
+
+
+class RobotStatePublisher(Node):
+    """Publishes the robot's link frames on ``/tf`` and ``/tf_static``.
+
+    Args:
+        context: the context the node joins.
+        robot_description: URDF/xacro XML, a file path or a loaded :class:`RobotModel`;
+            None reads the ``robot_description`` parameter.
+        node_name: defaults to ``robot_state_publisher``.
+        **node_kwargs: ``namespace``, ``parameter_overrides``, ``remappings`` of
+            :class:`~roverlab.core.Node`.
+
+    Parameters:
+        publish_frequency (double, 20.0): most publications per second of a joint (Hz).
+        ignore_timestamp (bool, False): publish every joint state, stamped now.
+        frame_prefix (string, ""): prepended to every frame id.
+
+    Raises:
+        DescriptionError: no description, or an invalid one.
+        ParameterError: a negative ``publish_frequency``.
+    """
+
+    def __init__(
+        self,
+        context: Context,
+        *,
+        robot_description: str | RobotModel | None = None,
+        node_name: str = "robot_state_publisher",
+        **node_kwargs: Any,
+    ) -> None:
+        super().__init__(node_name, context=context, **node_kwargs)
+        self.model = _robot(self, robot_description)
+        frequency = float(self.declare_parameter("publish_frequency", 20.0).value)
+        if frequency < 0.0:
+            raise ParameterError(f"{node_name}: publish_frequency must be >= 0, got {frequency}")
+        self.publish_interval = (
+            Duration.from_seconds(1.0 / frequency) if frequency > 0 else Duration(0)
+        )
+        self.ignore_timestamp = bool(self.declare_parameter("ignore_timestamp", False).value)
+        self.frame_prefix = str(self.declare_parameter("frame_prefix", "").value)
+
+        self._description_pub = self.create_publisher(String, "robot_description", _LATCHED)
+        self._description_pub.publish(String(data=self.model.urdf))
+        self._tf = TransformBroadcaster(self)
+        self._tf_static = StaticTransformBroadcaster(self)
+        self._movable = {j.name: j for j in self.model.movable_joints}
+        self._mimics: dict[str, list[Joint]] = {}
+        for j in self.model.movable_joints:
+            if j.mimic is not None:
+                self._mimics.setdefault(j.mimic.joint, []).append(j)
+        self._positions: dict[str, float] = {}
+        self._last_published: dict[str, Time] = {}
+        self.publish_fixed_transforms()
+        self.create_subscription(JointState, "joint_states", self._on_joint_states, 10)
+
+    def _frame(self, link: str) -> str:
+        return self.frame_prefix + link
+
+    def _msg(self, joint: Joint, stamp: Time, position: float = 0.0) -> Any:
+        return transform_to_msg(
+            self._frame(joint.parent), self._frame(joint.child), stamp, joint.transform(position)
+        )
+
+    def publish_fixed_transforms(self) -> None:
+        """(Re)publish every fixed joint on ``/tf_static``, stamped now."""
+        now = self.get_clock().now()
+        msgs = [self._msg(j, now) for j in self.model.fixed_joints]
+        if msgs:
+            self._tf_static.send_transform(msgs)
+
+    def _on_joint_states(self, msg: mc.JointState) -> None:
+        names = list(msg.name)
+        positions = list(msg.position)
+        if len(names) != len(positions):
+            self.get_logger().warning(
+                f"joint_states message has {len(names)} names but {len(positions)} positions; "
+                "ignored"
+            )
+            return
+        stamp = Time.from_msg(msg.header.stamp)
+        now = self.get_clock().now()
+        if self.ignore_timestamp or stamp.nanoseconds == 0:
+            stamp = now
+        last = now
+        for name in names:
+            t = self._last_published.get(name, Time(0))
+            last = t if t < last else last
+        if not (self.ignore_timestamp or stamp >= last + self.publish_interval):
+            return
+        updated: dict[str, Joint] = {}
+        for name, position in zip(names, positions, strict=True):
+            joint = self._movable.get(name)
+            if joint is None or joint.mimic is not None:
+                continue
+            self._positions[name] = float(position)
+            updated[name] = joint
+            for mimic in self._mimics.get(name, ()):
+                updated[mimic.name] = mimic
+        for name in names:
+            self._last_published[name] = stamp
+        if updated:
+            self._tf.send_transform(
+                [
+                    self._msg(j, stamp, self.model.joint_position(j, self._positions))
+                    for j in updated.values()
+                ]
+            )
+
+
+class JointStatePublisher(Node):
+    """Publishes ``/joint_states`` for the robot's movable joints.
+
+    Args:
+        context: the context the node joins.
+        robot_description: URDF/xacro XML, a file path or a loaded :class:`RobotModel`;
+            None reads the ``robot_description`` parameter.
+        node_name: defaults to ``joint_state_publisher``.
+        **node_kwargs: ``namespace``, ``parameter_overrides``, ``remappings``.
+
+    Parameters:
+        rate (double, 10.0): publications per second.
+        source_list (string array, []): JointState topics whose values override the
+            defaults (e.g. a simulator's wheel joint states).
+    """
+
+    def __init__(
+        self,
+        context: Context,
+        *,
+        robot_description: str | RobotModel | None = None,
+        node_name: str = "joint_state_publisher",
+        **node_kwargs: Any,
+    ) -> None:
+        super().__init__(node_name, context=context, **node_kwargs)
+        self.model = _robot(self, robot_description)
+        rate = float(self.declare_parameter("rate", 10.0).value)
+        if not rate > 0.0:
+            raise ParameterError(f"{node_name}: rate must be > 0, got {rate}")
+        sources = self.declare_parameter("source_list", None).value or []
+        if not isinstance(sources, list | tuple) or not all(isinstance(s, str) for s in sources):
+            raise ParameterError(f"{node_name}: source_list must be a list of topic names")
+        self.joints: tuple[Joint, ...] = self.model.movable_joints
+        self.source_positions: dict[str, float] = {}
+        self._velocities: dict[str, float] = {}
+        self._efforts: dict[str, float] = {}
+        self._pub = self.create_publisher(JointState, "joint_states", 10)
+        for topic in sources:
+            self.create_subscription(JointState, topic, self._on_source, 10)
+        self.create_timer(1.0 / rate, self.publish)
+
+    @staticmethod
+    def default_position(joint: Joint) -> float:
+        """0, or the middle of the limits when they exclude 0 (as joint_state_publisher)."""
+        limit = joint.limit
+        if (
+            joint.type in (JointType.REVOLUTE, JointType.PRISMATIC)
+            and limit is not None
+            and (limit.lower > 0.0 or limit.upper < 0.0)
+        ):
+            return (limit.lower + limit.upper) / 2.0
+        return 0.0
+
+    def _on_source(self, msg: mc.JointState) -> None:
+        for field, store in (
+            (msg.position, self.source_positions),
+            (msg.velocity, self._velocities),
+            (msg.effort, self._efforts),
+        ):
+            for name, value in zip(msg.name, field, strict=False):
+                store[str(name)] = float(value)
+
+    def positions(self) -> Mapping[str, float]:
+        """The positions the next message will carry, by joint name."""
+        free = {
+            j.name: self.source_positions.get(j.name, self.default_position(j))
+            for j in self.joints
+            if j.mimic is None
+        }
+        return {j.name: self.model.joint_position(j, free) for j in self.joints}
+
+    def publish(self) -> None:
+        """Publish one JointState now (the timer calls this every 1/rate s)."""
+        positions = self.positions()
+        names = [j.name for j in self.joints]
+        msg = JointState(
+            header=Header(stamp=self.get_clock().now().to_msg()),
+            name=names,
+            position=[positions[n] for n in names],
+            velocity=[self._velocities.get(n, 0.0) for n in names] if self._velocities else [],
+            effort=[self._efforts.get(n, 0.0) for n in names] if self._efforts else [],
+        )
+        self._pub.publish(msg)

@@ -1,0 +1,464 @@
+"""The simulator node (what ``gazebo_ros`` + the robot's ``<gazebo>`` plugins are in ROS).
+
+Thin: it wires :mod:`roverlab.sim.physics`, :mod:`roverlab.sim.collision` and
+:mod:`roverlab.sim.sensors` to topics, TF and parameters. Every random draw comes from a
+generator spawned from the ``seed`` parameter, so a seeded run is reproducible.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from roverlab.core import Node
+from roverlab.geometry import Transform3, quat_from_yaw, rpy_from_quat, wrap_angle
+from roverlab.msgs import classes as mc
+from roverlab.msgs import make_scan, xyz_to_pointcloud2
+from roverlab.raycast import Scene
+from roverlab.raycast.camera import camera_intrinsics, depth_to_points
+from roverlab.sim.collision import Obstacles, inner_radius
+from roverlab.sim.config import CameraSensor, DepthSensor, ImuSensor, LidarSensor, RobotSimConfig
+from roverlab.sim.dynamics import (
+    S_AL,
+    S_AR,
+    S_CONTACT,
+    S_DV,
+    S_ETH,
+    S_EX,
+    S_EY,
+    S_TH,
+    S_TL,
+    S_TR,
+    S_V,
+    S_VL,
+    S_VR,
+    S_W,
+    S_X,
+    S_Y,
+    STATE_SIZE,
+    advance,
+)
+from roverlab.sim.sensors import CameraModel, ImuModel, LidarModel
+from roverlab.tf import TransformBroadcaster
+
+__all__ = ["SimulatorNode", "SpawnPose"]
+
+_ODOM_POSE_COV = (1e-5, 1e-5, 1e12, 1e12, 1e12, 1e-3)  # as gazebo_ros_diff_drive
+_ODOM_TWIST_COV = (1e-5, 1e-5, 1e12, 1e12, 1e12, 1e-3)
+
+
+@dataclass(frozen=True)
+class SpawnPose:
+    x: float = 0.0
+    y: float = 0.0
+    yaw: float = 0.0
+
+
+def _stamp(ns: int) -> Any:
+    sec, nsec = divmod(ns, 1_000_000_000)
+    return mc.Time(sec=sec, nanosec=nsec)
+
+
+def _header(ns: int, frame: str) -> Any:
+    return mc.Header(stamp=_stamp(ns), frame_id=frame)
+
+
+def _diag_cov(values: tuple[float, ...]) -> np.ndarray:
+    cov = np.zeros(36)
+    cov[[0, 7, 14, 21, 28, 35]] = values
+    return cov
+
+
+def _pose_msg(x: float, y: float, yaw: float, cov: np.ndarray) -> Any:
+    q = quat_from_yaw(yaw)
+    return mc.PoseWithCovariance(
+        pose=mc.Pose(
+            position=mc.Point(x=x, y=y, z=0.0),
+            orientation=mc.Quaternion(x=0.0, y=0.0, z=float(q[2]), w=float(q[3])),
+        ),
+        covariance=cov,
+    )
+
+
+def _twist_msg(v: float, w: float, cov: np.ndarray) -> Any:
+    return mc.TwistWithCovariance(
+        twist=mc.Twist(linear=mc.Vector3(x=v, y=0.0, z=0.0), angular=mc.Vector3(x=0.0, y=0.0, z=w)),
+        covariance=cov,
+    )
+
+
+def _transform(ns: int, parent: str, child: str, x: float, y: float, yaw: float) -> Any:
+    q = quat_from_yaw(yaw)
+    return mc.TransformStamped(
+        header=_header(ns, parent),
+        child_frame_id=child,
+        transform=mc.Transform(
+            translation=mc.Vector3(x=x, y=y, z=0.0),
+            rotation=mc.Quaternion(x=0.0, y=0.0, z=float(q[2]), w=float(q[3])),
+        ),
+    )
+
+
+class SimulatorNode(Node):
+    """Simulates one differential-drive robot in a static 2.5-D world.
+
+    Publishes what the robot's Gazebo plugins would: odometry and the odom -> base
+    transform (diff drive), scans, IMU, camera and depth images and point clouds; plus the
+    ground-truth pose on ``/ground_truth/state`` (nav_msgs/Odometry in the ``world``
+    frame, like the p3d plugin). ``/clock`` comes from the context.
+
+    Parameters: ``seed`` (int), ``physics_rate`` (Hz, default 100), ``wheel_slip``
+    (relative 1-sigma slip per wheel and step, default 0.02; acts on encoder odometry
+    only), ``ground_truth_rate`` (Hz, default 50), ``ground_truth_topic``.
+    """
+
+    def __init__(
+        self,
+        *,
+        context: Any,
+        scene: Scene,
+        robot: RobotSimConfig,
+        spawn: SpawnPose | None = None,
+        seed: int = 0,
+        **kwargs: Any,
+    ) -> None:
+        super().__init__(kwargs.pop("node_name", "gazebo"), context=context, **kwargs)
+        self.scene = scene
+        self.robot = robot
+        spawn = spawn or SpawnPose()
+        self.seed = int(self.declare_parameter("seed", seed).value)
+        self.physics_rate = float(self.declare_parameter("physics_rate", 100.0).value)
+        self.wheel_slip = float(self.declare_parameter("wheel_slip", 0.02).value)
+        gt_rate = float(self.declare_parameter("ground_truth_rate", 50.0).value)
+        gt_topic = str(self.declare_parameter("ground_truth_topic", "/ground_truth/state").value)
+        if not (self.physics_rate > 0 and math.isfinite(self.physics_rate)):
+            raise ValueError(f"physics_rate must be > 0, got {self.physics_rate}")
+        seeds = np.random.SeedSequence(self.seed).spawn(
+            2 + len(robot.lidars) + len(robot.imus) + len(robot.cameras) + len(robot.depth_cameras)
+        )
+        rngs = [np.random.default_rng(s) for s in seeds]
+        self._slip_rng = rngs.pop(0)
+        self._spare_rng = rngs.pop(0)
+        # the physics state, advanced lazily in whole steps (see roverlab.sim.dynamics)
+        self._state = np.zeros(STATE_SIZE)
+        self._state[S_X], self._state[S_Y] = spawn.x, spawn.y
+        self._state[S_TH] = float(wrap_angle(spawn.yaw))
+        self._step_ns = round(1e9 / self.physics_rate)
+        self._physics_ns = self.get_clock().now_ns()
+        self._slip_block = 1 << 14
+        self._noise = self._slip_rng.standard_normal((self._slip_block, 2))
+        self._noise_pos = 0
+        self.obstacles = Obstacles(scene, z_min=robot.height_band[0], z_max=robot.height_band[1])
+        self._footprint = np.ascontiguousarray(robot.footprint, dtype=np.float64)
+        if self.obstacles.hits(robot.footprint, self.x, self.y, self.yaw):
+            self.get_logger().warning(
+                f"robot spawned in collision at ({self.x:.2f}, {self.y:.2f}): it cannot move"
+            )
+        # drive
+        self.drive = robot.drive
+        d = self.drive
+        self._params = np.array(
+            [
+                d.params.wheel_separation_m if d else 1.0,
+                d.params.wheel_diameter_m if d else 1.0,
+                d.params.wheel_acceleration if d else 0.0,
+                self.wheel_slip,
+                inner_radius(self._footprint),
+            ]
+        )
+        self.tf = TransformBroadcaster(self)
+        self._mounts: dict[int, tuple[float, float, float, float, float]] = {}
+        if self.drive is not None:
+            d = self.drive
+            self.create_subscription(mc.Twist, d.command_topic, self._on_cmd, 10)
+            self.odom_pub = self.create_publisher(mc.Odometry, d.odometry_topic, 10)
+            self.joint_pub = (
+                self.create_publisher(mc.JointState, "joint_states", 10)
+                if d.publish_wheel_joint_state
+                else None
+            )
+            self.create_timer(1.0 / d.update_rate_hz, self._publish_odometry)
+        self._pose_cov = _diag_cov(_ODOM_POSE_COV)
+        self._twist_cov = _diag_cov(_ODOM_TWIST_COV)
+        self.gt_pub = self.create_publisher(mc.Odometry, gt_topic, 10)
+        self.create_timer(1.0 / gt_rate, self._publish_ground_truth)
+        for lidar in robot.lidars:
+            self._add_lidar(lidar, rngs.pop(0))
+        for imu in robot.imus:
+            self._add_imu(imu, rngs.pop(0))
+        for cam in robot.cameras:
+            self._add_camera(cam, rngs.pop(0))
+        for depth in robot.depth_cameras:
+            self._add_depth(depth, rngs.pop(0))
+
+    # ----------------------------------------------------------------- state
+    @property
+    def x(self) -> float:
+        return float(self._state[S_X])
+
+    @property
+    def y(self) -> float:
+        return float(self._state[S_Y])
+
+    @property
+    def yaw(self) -> float:
+        return float(self._state[S_TH])
+
+    @property
+    def v(self) -> float:
+        return float(self._state[S_V])
+
+    @property
+    def w(self) -> float:
+        return float(self._state[S_W])
+
+    @property
+    def contact(self) -> bool:
+        return bool(self._state[S_CONTACT])
+
+    def advance(self) -> None:
+        """Run every physics step up to the current clock time."""
+        now = self.get_clock().now_ns()
+        steps = (now - self._physics_ns) // self._step_ns
+        if steps <= 0:
+            return
+        self._physics_ns += steps * self._step_ns
+        if self.drive is None:
+            return
+        if self._noise_pos + steps > self._slip_block:
+            self._noise = self._slip_rng.standard_normal((self._slip_block, 2))
+            self._noise_pos = 0
+        while steps > 0:
+            chunk = min(steps, self._slip_block - self._noise_pos)
+            self._noise_pos = advance(
+                self._state,
+                self._params,
+                chunk,
+                self._step_ns / 1e9,
+                self._footprint,
+                self.obstacles.segments,
+                self.obstacles.circles,
+                self._noise,
+                self._noise_pos,
+            )
+            steps -= chunk
+            if steps > 0:
+                self._noise = self._slip_rng.standard_normal((self._slip_block, 2))
+                self._noise_pos = 0
+
+    # ----------------------------------------------------------------- commands
+    def _on_cmd(self, msg: Any) -> None:
+        v, w = float(msg.linear.x), float(msg.angular.z)
+        if not (math.isfinite(v) and math.isfinite(w)):
+            self.get_logger().warning("ignoring a cmd_vel with a NaN or infinite velocity")
+            return
+        assert self.drive is not None
+        self.advance()
+        p = self.drive.params
+        half = 0.5 * p.wheel_separation_m * w
+        lim = p.max_wheel_speed_mps
+        self._state[S_TL] = max(-lim, min(lim, v - half))
+        self._state[S_TR] = max(-lim, min(lim, v + half))
+
+    # ----------------------------------------------------------------- odometry
+    def odometry_pose(self) -> tuple[float, float, float]:
+        """The pose the diff-drive plugin reports (world pose, or integrated encoders)."""
+        self.advance()
+        st = self._state
+        if self.drive is not None and self.drive.odometry_source == "encoder":
+            return float(st[S_EX]), float(st[S_EY]), float(st[S_ETH])
+        return float(st[S_X]), float(st[S_Y]), float(st[S_TH])
+
+    def _publish_odometry(self) -> None:
+        d = self.drive
+        assert d is not None
+        ns = self.get_clock().now_ns()
+        x, y, yaw = self.odometry_pose()
+        st = self._state
+        if d.odometry_source == "encoder":
+            v = 0.5 * (st[S_VL] + st[S_VR])
+            w = (st[S_VR] - st[S_VL]) / d.params.wheel_separation_m
+        else:
+            v, w = self.v, self.w
+        self.odom_pub.publish(
+            mc.Odometry(
+                header=_header(ns, d.odometry_frame),
+                child_frame_id=d.robot_base_frame,
+                pose=_pose_msg(x, y, yaw, self._pose_cov),
+                twist=_twist_msg(v, w, self._twist_cov),
+            )
+        )
+        if d.publish_odom_tf:
+            self.tf.send_transform(_transform(ns, d.odometry_frame, d.robot_base_frame, x, y, yaw))
+        if self.joint_pub is not None:
+            self.joint_pub.publish(
+                mc.JointState(
+                    header=_header(ns, ""),
+                    name=[d.left_joint, d.right_joint],
+                    position=np.array([st[S_AL], st[S_AR]]),
+                    velocity=np.array([st[S_VL], st[S_VR]]) * (2.0 / d.params.wheel_diameter_m),
+                    effort=np.zeros(2),
+                )
+            )
+
+    def _publish_ground_truth(self) -> None:
+        if not self.gt_pub.has_listeners:
+            return
+        self.advance()
+        ns = self.get_clock().now_ns()
+        zero = np.zeros(36)
+        self.gt_pub.publish(
+            mc.Odometry(
+                header=_header(ns, "world"),
+                child_frame_id=self.robot.base_frame,
+                pose=_pose_msg(self.x, self.y, self.yaw, zero),
+                twist=_twist_msg(self.v, self.w, zero),
+            )
+        )
+
+    # ----------------------------------------------------------------- sensors
+    def sensor_pose(self, mount: Transform3) -> tuple[float, float, float, float, float]:
+        """World (x, y, z, yaw, pitch) of a sensor mounted at ``mount`` on the base.
+
+        The base moves in the plane (no roll or pitch), so this is planar arithmetic on
+        the mount's offsets, cached per mount.
+        """
+        self.advance()
+        m = self._mounts.get(id(mount))
+        if m is None:
+            _, pitch, myaw = rpy_from_quat(mount.rotation)
+            m = self._mounts[id(mount)] = (*mount.translation, myaw, pitch)
+        mx, my, mz, myaw, pitch = m
+        c, s = math.cos(self.yaw), math.sin(self.yaw)
+        return (
+            self.x + c * mx - s * my,
+            self.y + s * mx + c * my,
+            mz,
+            float(wrap_angle(self.yaw + myaw)),
+            pitch,
+        )
+
+    def _add_lidar(self, sensor: LidarSensor, rng: np.random.Generator) -> None:
+        model = LidarModel(sensor.params, rng)
+        pub = self.create_publisher(mc.LaserScan, sensor.topic, 10)
+        p = sensor.params
+        scan_time = 1.0 / sensor.update_rate_hz
+
+        def tick() -> None:
+            x, y, z, yaw, _ = self.sensor_pose(sensor.mount)
+            ranges = model.scan(self.scene, x, y, z, yaw)
+            pub.publish(
+                make_scan(
+                    ranges,
+                    angle_min=p.min_angle,
+                    angle_max=p.max_angle,
+                    range_min=p.range_min,
+                    range_max=p.range_max,
+                    frame_id=sensor.frame_id,
+                    stamp=self.get_clock().now_ns(),
+                    scan_time=scan_time,
+                )
+            )
+
+        self.create_timer(scan_time, tick)
+
+    def _add_imu(self, sensor: ImuSensor, rng: np.random.Generator) -> None:
+        model = ImuModel(sensor.rate, sensor.accel, rng, gaussian_noise=sensor.gaussian_noise)
+        pub = self.create_publisher(mc.Imu, sensor.topic, 10)
+        rate = sensor.update_rate_hz if sensor.update_rate_hz > 0 else self.physics_rate
+        cov = np.zeros(9)
+
+        def tick() -> None:
+            self.advance()
+            q, gyro, acc = model.measure(self.yaw, self.v, self.w, float(self._state[S_DV]))
+            pub.publish(
+                mc.Imu(
+                    header=_header(self.get_clock().now_ns(), sensor.frame_id),
+                    orientation=mc.Quaternion(x=q[0], y=q[1], z=q[2], w=q[3]),
+                    orientation_covariance=cov,
+                    angular_velocity=mc.Vector3(x=gyro[0], y=gyro[1], z=gyro[2]),
+                    angular_velocity_covariance=cov,
+                    linear_acceleration=mc.Vector3(x=acc[0], y=acc[1], z=acc[2]),
+                    linear_acceleration_covariance=cov,
+                )
+            )
+
+        self.create_timer(1.0 / rate, tick)
+
+    def _camera_info(self, ns: int, frame: str, model: CameraModel) -> Any:
+        p = model.params
+        k = camera_intrinsics(p.width, p.height, p.horizontal_fov).k
+        proj = np.zeros((3, 4))
+        proj[:, :3] = k
+        return mc.CameraInfo(
+            header=_header(ns, frame),
+            height=p.height,
+            width=p.width,
+            distortion_model="plumb_bob",
+            d=np.zeros(5),
+            k=k.reshape(-1),
+            r=np.eye(3).reshape(-1),
+            p=proj.reshape(-1),
+            binning_x=0,
+            binning_y=0,
+            roi=mc.RegionOfInterest(x_offset=0, y_offset=0, height=0, width=0, do_rectify=False),
+        )
+
+    def _add_camera(self, sensor: CameraSensor, rng: np.random.Generator) -> None:
+        model = CameraModel(sensor.params, rng)
+        image_pub = self.create_publisher(mc.Image, sensor.image_topic, 2)
+        info_pub = self.create_publisher(mc.CameraInfo, sensor.info_topic, 2)
+
+        def tick() -> None:
+            ns = self.get_clock().now_ns()
+            x, y, z, yaw, pitch = self.sensor_pose(sensor.mount)
+            rgb, _ = model.capture(self.scene, x, y, z, yaw, pitch)
+            image_pub.publish(_image(ns, sensor.frame_id, rgb, "rgb8"))
+            info_pub.publish(self._camera_info(ns, sensor.frame_id, model))
+
+        self.create_timer(1.0 / sensor.update_rate_hz, tick)
+
+    def _add_depth(self, sensor: DepthSensor, rng: np.random.Generator) -> None:
+        model = CameraModel(sensor.params, rng)
+        image_pub = self.create_publisher(mc.Image, sensor.image_topic, 2)
+        info_pub = self.create_publisher(mc.CameraInfo, sensor.info_topic, 2)
+        depth_pub = self.create_publisher(mc.Image, sensor.depth_topic, 2)
+        dinfo_pub = self.create_publisher(mc.CameraInfo, sensor.depth_info_topic, 2)
+        points_pub = self.create_publisher(mc.PointCloud2, sensor.points_topic, 2)
+        p = sensor.params
+
+        def tick() -> None:
+            ns = self.get_clock().now_ns()
+            x, y, z, yaw, pitch = self.sensor_pose(sensor.mount)
+            rgb, depth = model.capture(self.scene, x, y, z, yaw, pitch)
+            image_pub.publish(_image(ns, sensor.frame_id, rgb, "rgb8"))
+            depth_pub.publish(_image(ns, sensor.frame_id, depth, "32FC1"))
+            info = self._camera_info(ns, sensor.frame_id, model)
+            info_pub.publish(info)
+            dinfo_pub.publish(info)
+            pts = depth_to_points(depth, p.horizontal_fov)
+            valid = (np.isfinite(depth) & (depth > 0)).reshape(-1)
+            colors = rgb.reshape(-1, 3)[valid]
+            keep = (pts[:, 2] >= sensor.point_cloud_cutoff) & (
+                pts[:, 2] <= sensor.point_cloud_cutoff_max
+            )
+            points_pub.publish(xyz_to_pointcloud2(pts[keep], sensor.frame_id, ns, rgb=colors[keep]))
+
+        self.create_timer(1.0 / sensor.update_rate_hz, tick)
+
+
+def _image(ns: int, frame: str, arr: np.ndarray, encoding: str) -> Any:
+    height, width = arr.shape[:2]
+    data = np.ascontiguousarray(arr)
+    return mc.Image(
+        header=_header(ns, frame),
+        height=height,
+        width=width,
+        encoding=encoding,
+        is_bigendian=0,
+        step=data.strides[0],
+        data=data.reshape(-1).view(np.uint8),
+    )

@@ -1,0 +1,245 @@
+"""Turn a URDF/xacro robot's ``<gazebo>`` extensions into the simulator's configuration."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.spatial import ConvexHull, QhullError
+
+from roverlab.description import (
+    Box,
+    CameraPluginSpec,
+    Cylinder,
+    DiffDriveSpec,
+    GazeboSensor,
+    ImuPluginSpec,
+    KinectPluginSpec,
+    LaserPluginSpec,
+    NoiseSpec,
+    RobotModel,
+    Sphere,
+)
+from roverlab.description.errors import DescriptionError
+from roverlab.geometry import Transform3
+from roverlab.sim.config import (
+    CameraSensor,
+    DepthSensor,
+    DiffDriveConfig,
+    ImuSensor,
+    LidarSensor,
+    RobotSimConfig,
+)
+from roverlab.sim.physics import DiffDriveParams
+from roverlab.sim.sensors import CameraParams, ImuNoise, LidarParams
+
+__all__ = ["sim_config_from_model"]
+
+F64 = NDArray[np.float64]
+
+
+def _geometry_points(geom: object) -> F64:
+    """Sample points on a geometry's surface, in its own frame."""
+    if isinstance(geom, Box):
+        sx, sy, sz = (0.5 * v for v in geom.size)
+        return np.array(
+            [[x, y, z] for x in (-sx, sx) for y in (-sy, sy) for z in (-sz, sz)], dtype=np.float64
+        )
+    a = np.linspace(0, 2 * math.pi, 16, endpoint=False)
+    if isinstance(geom, Cylinder):
+        ring = np.stack([geom.radius * np.cos(a), geom.radius * np.sin(a)], axis=1)
+        h = 0.5 * geom.length
+        return np.vstack(
+            [np.column_stack([ring, np.full(16, -h)]), np.column_stack([ring, np.full(16, h)])]
+        )
+    if isinstance(geom, Sphere):
+        r = geom.radius
+        ring = np.stack([r * np.cos(a), r * np.sin(a), np.zeros(16)], axis=1)
+        return np.vstack([ring, [[0, 0, r], [0, 0, -r]]])
+    return np.zeros((0, 3))  # meshes: no shape information without loading the mesh
+
+
+def _body_points(model: RobotModel, base: str) -> F64:
+    """Surface points of every collision (or, if the robot has none, visual) shape."""
+    use_collisions = any(link.collisions for link in model.links.values())
+    poses = model.link_transforms()
+    base_inv = ~poses[base]
+    pts: list[F64] = []
+    for name, link in model.links.items():
+        shapes = link.collisions if use_collisions else link.visuals
+        for shape in shapes:
+            local = _geometry_points(shape.geometry)
+            if len(local):
+                pts.append((base_inv * poses[name] * shape.origin).apply(local))
+    return np.vstack(pts) if pts else np.zeros((0, 3))
+
+
+def _footprint(points: F64) -> F64:
+    xy = points[:, :2]
+    if len(xy) < 3:
+        return np.array([[-0.1, -0.1], [0.1, -0.1], [0.1, 0.1], [-0.1, 0.1]])
+    try:
+        hull = ConvexHull(xy)
+    except QhullError:
+        lo, hi = xy.min(axis=0), xy.max(axis=0) + 1e-3
+        return np.array([[lo[0], lo[1]], [hi[0], lo[1]], [hi[0], hi[1]], [lo[0], hi[1]]])
+    return np.ascontiguousarray(xy[hull.vertices])
+
+
+def _noise(n: NoiseSpec | None) -> ImuNoise:
+    if n is None:
+        return ImuNoise()
+    return ImuNoise(n.mean, n.stddev, n.bias_mean, n.bias_stddev)
+
+
+def _mount(model: RobotModel, base: str, sensor: GazeboSensor) -> Transform3:
+    poses = model.link_transforms()
+    return (~poses[base]) * poses[sensor.reference_link] * sensor.pose
+
+
+def _rate(plugin_rate: float, sensor_rate: float, default: float) -> float:
+    for r in (plugin_rate, sensor_rate):
+        if r > 0:
+            return r
+    return default
+
+
+def sim_config_from_model(model: RobotModel) -> RobotSimConfig:
+    """Body outline, drive and sensors of a robot, as its Gazebo plugins configure them.
+
+    Raises:
+        DescriptionError: a sensor or plugin refers to something the model lacks.
+    """
+    gz = model.gazebo
+    dd: DiffDriveSpec | None = gz.diff_drive
+    base = dd.robot_base_frame if dd is not None else model.root_link
+    if base not in model.links:
+        raise DescriptionError(
+            f"{model.source}: diff drive robotBaseFrame '{base}' is not a link of the robot"
+        )
+    points = _body_points(model, base)
+    zs = points[:, 2] if len(points) else np.array([0.0, 0.3])
+    drive = None
+    if dd is not None:
+        drive = DiffDriveConfig(
+            params=DiffDriveParams(
+                wheel_separation_m=dd.wheel_separation_m,
+                wheel_diameter_m=dd.wheel_diameter_m,
+                wheel_acceleration=dd.wheel_acceleration,
+            ),
+            command_topic=dd.command_topic,
+            odometry_topic=dd.odometry_topic,
+            odometry_frame=dd.odometry_frame,
+            robot_base_frame=dd.robot_base_frame,
+            publish_odom_tf=dd.publish_odom_tf and dd.publish_tf,
+            publish_wheel_joint_state=dd.publish_wheel_joint_state,
+            odometry_source=dd.odometry_source,
+            update_rate_hz=dd.update_rate_hz if dd.update_rate_hz > 0 else 100.0,
+            left_joint=dd.left_joint,
+            right_joint=dd.right_joint,
+        )
+    lidars: list[LidarSensor] = []
+    cameras: list[CameraSensor] = []
+    depths: list[DepthSensor] = []
+    unsupported = [p.filename for p in gz.unsupported_plugins]
+    for sensor in gz.sensors:
+        mount = _mount(model, base, sensor)
+        if sensor.ray is not None:
+            laser = next(
+                (p.spec for p in sensor.plugins if isinstance(p.spec, LaserPluginSpec)), None
+            )
+            if laser is None:
+                continue  # a ray sensor without the ROS plugin publishes nothing in ROS
+            r = sensor.ray
+            lidars.append(
+                LidarSensor(
+                    name=sensor.name,
+                    params=LidarParams(
+                        samples=r.range_count,
+                        min_angle=r.min_angle,
+                        max_angle=r.max_angle,
+                        range_min=r.range_min,
+                        range_max=r.range_max,
+                        range_resolution=r.range_resolution,
+                        noise_mean=r.noise_mean if r.noise_type == "gaussian" else 0.0,
+                        noise_stddev=r.noise_stddev if r.noise_type == "gaussian" else 0.0,
+                    ),
+                    mount=mount,
+                    update_rate_hz=_rate(0.0, sensor.update_rate_hz, 10.0),
+                    topic=laser.topic,
+                    frame_id=laser.frame_id,
+                )
+            )
+        elif sensor.camera is not None:
+            c = sensor.camera
+            params = CameraParams(
+                width=c.width,
+                height=c.height,
+                horizontal_fov=c.horizontal_fov,
+                clip_near=c.clip_near,
+                clip_far=c.clip_far,
+                noise_mean=c.noise_mean if c.noise_type == "gaussian" else 0.0,
+                noise_stddev=c.noise_stddev if c.noise_type == "gaussian" else 0.0,
+            )
+            cam = next(
+                (p.spec for p in sensor.plugins if isinstance(p.spec, CameraPluginSpec)), None
+            )
+            kin = next(
+                (p.spec for p in sensor.plugins if isinstance(p.spec, KinectPluginSpec)), None
+            )
+            if kin is not None:
+                depths.append(
+                    DepthSensor(
+                        name=sensor.name,
+                        params=params,
+                        mount=mount,
+                        update_rate_hz=_rate(kin.update_rate_hz, sensor.update_rate_hz, 10.0),
+                        image_topic=kin.image_topic,
+                        info_topic=kin.camera_info_topic,
+                        depth_topic=kin.depth_image_topic,
+                        depth_info_topic=kin.depth_image_camera_info_topic,
+                        points_topic=kin.point_cloud_topic,
+                        frame_id=kin.frame_id,
+                        point_cloud_cutoff=kin.point_cloud_cutoff_m,
+                        point_cloud_cutoff_max=kin.point_cloud_cutoff_max_m,
+                    )
+                )
+            elif cam is not None:
+                cameras.append(
+                    CameraSensor(
+                        name=sensor.name,
+                        params=params,
+                        mount=mount,
+                        update_rate_hz=_rate(cam.update_rate_hz, sensor.update_rate_hz, 30.0),
+                        image_topic=cam.image_topic,
+                        info_topic=cam.camera_info_topic,
+                        frame_id=cam.frame_id,
+                    )
+                )
+    imus: list[ImuSensor] = []
+    for spec in gz.specs(ImuPluginSpec):
+        noise = spec.noise
+        imus.append(
+            ImuSensor(
+                name=spec.body_name,
+                rate=_noise(noise.rate if noise else None),
+                accel=_noise(noise.accel if noise else None),
+                gaussian_noise=spec.gaussian_noise,
+                update_rate_hz=spec.update_rate_hz,
+                topic=spec.topic,
+                frame_id=spec.frame_id,
+            )
+        )
+    return RobotSimConfig(
+        name=model.name,
+        footprint=_footprint(points) if len(points) else _footprint(np.zeros((0, 3))),
+        height_band=(0.02, float(max(zs.max(), 0.05))),
+        drive=drive,
+        lidars=tuple(lidars),
+        imus=tuple(imus),
+        cameras=tuple(cameras),
+        depth_cameras=tuple(depths),
+        base_frame=base,
+        unsupported=tuple(unsupported),
+    )

@@ -1,0 +1,219 @@
+"""Sensor models: lidar, IMU and cameras over the shared ray-casting kernels.
+
+Pure: each model takes poses and a seeded ``np.random.Generator`` and returns arrays.
+Noise follows Gazebo's sensor noise model: Gaussian with a mean and a standard deviation,
+plus (for the IMU) a constant bias drawn once per run from N(bias_mean, bias_stddev).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from roverlab.raycast import Scene
+from roverlab.raycast.camera import render
+from roverlab.raycast.lidar import cast_2d
+
+__all__ = ["CameraModel", "ImuModel", "ImuNoise", "LidarModel", "LidarParams"]
+
+F64 = NDArray[np.float64]
+GRAVITY = 9.80665
+_BLOCK = 1024
+
+
+@dataclass(frozen=True, slots=True)
+class LidarParams:
+    """A Gazebo ``ray`` sensor's horizontal scan.
+
+    ``samples`` beams from ``min_angle`` to ``max_angle`` inclusive (Gazebo spaces them by
+    ``(max - min) / (samples - 1)``), ranges limited to [range_min, range_max], quantised to
+    ``range_resolution`` (0 = none) and disturbed by N(noise_mean, noise_stddev).
+    """
+
+    samples: int
+    min_angle: float
+    max_angle: float
+    range_min: float
+    range_max: float
+    range_resolution: float = 0.0
+    noise_mean: float = 0.0
+    noise_stddev: float = 0.0
+    height_m: float = 0.2
+
+    def __post_init__(self) -> None:
+        if self.samples < 1:
+            raise ValueError(f"lidar samples must be >= 1, got {self.samples}")
+        if not (0 <= self.range_min < self.range_max):
+            raise ValueError(
+                f"lidar range must satisfy 0 <= min < max, got {self.range_min}, {self.range_max}"
+            )
+        if self.max_angle < self.min_angle:
+            raise ValueError("lidar max_angle must be >= min_angle")
+
+    @property
+    def angle_increment(self) -> float:
+        return 0.0 if self.samples == 1 else (self.max_angle - self.min_angle) / (self.samples - 1)
+
+    def angles(self) -> F64:
+        return self.min_angle + self.angle_increment * np.arange(self.samples, dtype=np.float64)
+
+
+class LidarModel:
+    """A 2-D scanning lidar: exact ray cast, Gaussian noise, range quantisation.
+
+    Returned ranges follow REP 117: ``+inf`` where nothing is within ``range_max`` and
+    ``-inf`` where the return is closer than ``range_min``.
+    """
+
+    def __init__(self, params: LidarParams, rng: np.random.Generator) -> None:
+        self.params = params
+        self.rng = rng
+        self._rel = params.angles()
+
+    def scan(self, scene: Scene, x: float, y: float, z: float, yaw: float) -> NDArray[np.float32]:
+        p = self.params
+        exact = cast_2d(scene, x, y, z, self._rel + yaw, p.range_max)
+        ranges = exact.copy()
+        hit = np.isfinite(ranges)
+        if p.noise_stddev > 0 or p.noise_mean != 0:
+            ranges[hit] += (
+                self.rng.normal(p.noise_mean, p.noise_stddev, int(hit.sum()))
+                if p.noise_stddev > 0
+                else p.noise_mean
+            )
+        if p.range_resolution > 0:
+            ranges[hit] = np.round(ranges[hit] / p.range_resolution) * p.range_resolution
+        ranges[hit & (ranges > p.range_max)] = np.inf
+        ranges[hit & (ranges < p.range_min)] = -np.inf
+        return ranges.astype(np.float32)
+
+
+@dataclass(frozen=True, slots=True)
+class ImuNoise:
+    """Gazebo IMU noise of one quantity (angular rate or linear acceleration)."""
+
+    mean: float = 0.0
+    stddev: float = 0.0
+    bias_mean: float = 0.0
+    bias_stddev: float = 0.0
+
+
+class ImuModel:
+    """Angular velocity, linear acceleration (with gravity) and orientation of a body.
+
+    The bias of each axis is drawn once, as Gazebo does: magnitude from
+    N(bias_mean, bias_stddev) with a random sign.
+    """
+
+    def __init__(
+        self,
+        rate: ImuNoise,
+        accel: ImuNoise,
+        rng: np.random.Generator,
+        *,
+        gaussian_noise: float = 0.0,
+    ) -> None:
+        self.rate_noise = rate
+        self.accel_noise = accel
+        self.gaussian_noise = gaussian_noise
+        self.rng = rng
+        self.rate_bias = self._bias(rate)
+        self.accel_bias = self._bias(accel)
+        self._rate_bias = self.rate_bias.tolist()
+        self._accel_bias = self.accel_bias.tolist()
+        self._block: list[list[float]] = []
+        self._pos = 0
+
+    def _bias(self, n: ImuNoise) -> F64:
+        mag = (
+            self.rng.normal(n.bias_mean, n.bias_stddev, 3)
+            if n.bias_stddev > 0
+            else np.full(3, n.bias_mean)
+        )
+        sign = np.where(self.rng.random(3) < 0.5, -1.0, 1.0)
+        return mag * sign
+
+    def _normals(self) -> list[float]:
+        """12 standard normals for one measurement, drawn in blocks (same sequence)."""
+        if self._pos >= len(self._block):
+            self._block = self.rng.standard_normal((_BLOCK, 12)).tolist()
+            self._pos = 0
+        row = self._block[self._pos]
+        self._pos += 1
+        return row
+
+    def measure(
+        self, yaw: float, v: float, w: float, dv_dt: float
+    ) -> tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...]]:
+        """(quaternion xyzw, angular velocity, linear acceleration) in the body frame.
+
+        ``v``/``w`` are the body's forward and yaw rates, ``dv_dt`` its forward acceleration;
+        the centripetal term ``v * w`` appears on y and gravity on z, as a real IMU reads.
+        Plain floats: this runs at the IMU rate.
+        """
+        z = self._normals()
+        rn, an, g = self.rate_noise, self.accel_noise, self.gaussian_noise
+        rb, ab = self._rate_bias, self._accel_bias
+        gyro = tuple(
+            true + rb[i] + rn.mean + rn.stddev * z[i] + g * z[6 + i]
+            for i, true in enumerate((0.0, 0.0, w))
+        )
+        acc = tuple(
+            true + ab[i] + an.mean + an.stddev * z[3 + i] + g * z[9 + i]
+            for i, true in enumerate((dv_dt, v * w, GRAVITY))
+        )
+        return (0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2)), gyro, acc
+
+
+@dataclass(frozen=True, slots=True)
+class CameraParams:
+    """A pinhole camera as Gazebo's ``<camera>``: image size, fov, clip, noise."""
+
+    width: int
+    height: int
+    horizontal_fov: float
+    clip_near: float = 0.02
+    clip_far: float = 300.0
+    noise_mean: float = 0.0
+    noise_stddev: float = 0.0
+
+    def __post_init__(self) -> None:
+        if self.width < 1 or self.height < 1:
+            raise ValueError(f"camera size must be positive, got {self.width}x{self.height}")
+        if not (0 < self.horizontal_fov < math.pi):
+            raise ValueError(f"camera horizontal_fov must be in (0, pi), got {self.horizontal_fov}")
+        if not (0 < self.clip_near < self.clip_far):
+            raise ValueError("camera clip must satisfy 0 < near < far")
+
+
+class CameraModel:
+    """RGB and depth images rendered from the 2.5-D scene, with Gazebo's pixel noise."""
+
+    def __init__(self, params: CameraParams, rng: np.random.Generator) -> None:
+        self.params = params
+        self.rng = rng
+
+    def capture(
+        self, scene: Scene, x: float, y: float, z: float, yaw: float, pitch: float = 0.0
+    ) -> tuple[NDArray[np.uint8], NDArray[np.float32]]:
+        p = self.params
+        rgb, depth = render(
+            scene,
+            x,
+            y,
+            z,
+            yaw,
+            hfov=p.horizontal_fov,
+            width=p.width,
+            height=p.height,
+            near=p.clip_near,
+            far=p.clip_far,
+            pitch=pitch,
+        )
+        if p.noise_stddev > 0 or p.noise_mean != 0:
+            noise = self.rng.normal(p.noise_mean, p.noise_stddev, rgb.shape) * 255.0
+            rgb = np.clip(rgb.astype(np.float32) + noise, 0, 255).astype(np.uint8)
+        return rgb, depth

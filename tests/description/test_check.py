@@ -1,0 +1,65 @@
+"""check_urdf's text, and the sensor/plugin listing after it."""
+
+from __future__ import annotations
+
+from roverlab.description import format_check, format_tree, load_robot
+from tests.description.conftest import MYBOT_URDF, MYBOT_XACRO, robot
+
+MYBOT_CHECK_URDF = """\
+robot name is: mybot
+---------- Successfully Parsed XML ---------------
+root Link: base_footprint has 1 child(ren)
+    child(1):  base_link
+        child(1):  ball_wheel_link
+        child(2):  left_wheel_link
+        child(3):  right_wheel_link"""
+
+
+def test_tree_is_check_urdf_byte_for_byte() -> None:
+    assert format_tree(load_robot(MYBOT_URDF)) == MYBOT_CHECK_URDF
+
+
+def test_children_are_ordered_by_joint_name_as_urdfdom() -> None:
+    m = load_robot(
+        robot(
+            '<link name="root"/><link name="zeta"/><link name="alpha"/><link name="deep"/>'
+            '<joint name="b_joint" type="fixed"><parent link="root"/><child link="alpha"/></joint>'
+            '<joint name="a_joint" type="fixed"><parent link="root"/><child link="zeta"/></joint>'
+            '<joint name="c" type="fixed"><parent link="zeta"/><child link="deep"/></joint>',
+            "order",
+        )
+    )
+    assert format_tree(m).splitlines()[2:] == [
+        "root Link: root has 2 child(ren)",
+        "    child(1):  zeta",
+        "        child(1):  deep",
+        "    child(2):  alpha",
+    ]
+
+
+def test_check_lists_sensors_and_plugins() -> None:
+    text = format_check(load_robot(MYBOT_XACRO))
+    assert text.startswith("robot name is: mybot\n")
+    assert "---------- Gazebo sensors: 3 ---------------" in text
+    assert "  rplidar_sensor (ray) on base_laser_link: 720 samples" in text
+    assert "range 0.12-12 m, 7 Hz" in text
+    assert "  csi Camera (camera) on base_camera_link: 640x480 R8G8B8" in text
+    assert "---------- Gazebo plugins: 4 ---------------" in text
+    assert "separation 0.18 m, diameter 0.05 m" in text
+    assert "[libgazebo_ros_camera.so] on sensor 'csi Camera': /image_raw" in text
+    assert "unsupported" not in text
+
+
+def test_check_marks_unsupported_plugins_and_unknown_references() -> None:
+    m = load_robot(
+        robot(
+            '<link name="a"/><gazebo><plugin name="ctl" filename="libgazebo_ros_control.so"/>'
+            '</gazebo><gazebo reference="ghost"><material>Gazebo/Red</material></gazebo>'
+            '<gazebo reference="a"><sensor type="sonar" name="s"/></gazebo>'
+        )
+    )
+    text = format_check(m)
+    assert "  ctl [libgazebo_ros_control.so] on model: not supported by roverlab" in text
+    assert "  s (sonar) on a: not supported by roverlab" in text
+    assert "unsupported (ignored): plugin libgazebo_ros_control.so, sensor type sonar" in text
+    assert "warning: <gazebo reference> names no link or joint: 'ghost'" in text
