@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from roverlab.raycast import Grid, RaycastInputError, Scene, build_grid, scene_grid
-from roverlab.raycast.accel import circle_hit, segment_hit
+from roverlab.raycast.accel import circle_hit, segment_distance, segment_hit
 from tests.raycast.helpers import random_scene
 
 
@@ -87,3 +87,23 @@ def test_primitive_tests() -> None:
     t_in, t_out = circle_hit(5.0, 0.0, 1.0, 0.0, 5.0, 0.0, 1.0)
     assert (t_in, t_out) == (0.0, 1.0)
     assert math.isinf(circle_hit(0.0, 0.0, 0.0, 1.0, 5.0, 0.0, 1.0)[0])
+
+
+def test_segment_distance_matches_segment_hit() -> None:
+    rng = np.random.default_rng(11)
+    n_hit = 0
+    for _ in range(3000):
+        ox, oy, x0, y0, x1, y1 = rng.uniform(-3, 3, 6)
+        a = rng.uniform(-4, 4)
+        dx, dy = math.cos(a), math.sin(a)
+        t, _ = segment_hit(ox, oy, dx, dy, x0, y0, x1, y1)
+        assert segment_distance(ox, oy, dx, dy, x0, y0, x1, y1, math.inf) == t
+        if math.isfinite(t):
+            n_hit += 1
+            far = t * (1 - 1e-9)
+            assert segment_distance(ox, oy, dx, dy, x0, y0, x1, y1, far) == math.inf  # not closer
+            assert segment_distance(ox, oy, dx, dy, x0, y0, x1, y1, t * 1.01 + 1e-9) == t
+    assert n_hit > 300
+    # collinear (zero determinant): the nearest end
+    assert segment_distance(0.0, 0.0, 1.0, 0.0, 3.0, 0.0, 2.0, 0.0, math.inf) == 2.0
+    assert segment_distance(0.0, 0.0, 1.0, 0.0, 3.0, 0.0, 2.0, 0.0, 1.5) == math.inf

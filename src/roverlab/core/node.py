@@ -137,6 +137,31 @@ class Subscription:
         self.node.destroy_subscription(self)
 
 
+class _TimerFire:
+    """The heap entry of one timer generation: firing it runs the timer, unless the
+    timer was cancelled or reset since (a new generation has its own entry)."""
+
+    __slots__ = ("__self__", "generation")
+
+    def __init__(self, timer: Timer) -> None:
+        self.__self__ = timer  # lets the executor's error report name the owner
+        self.generation = timer._generation
+
+    def __call__(self) -> None:
+        timer = self.__self__
+        if timer.cancelled or self.generation != timer._generation:
+            return
+        period = timer.period_ns
+        nxt = timer._next_ns + period
+        ex = timer._executor
+        now = ex.now_ns
+        if nxt <= now:  # the clock jumped past whole periods: skip them, as rcl does
+            nxt += ((now - nxt) // period + 1) * period
+        timer._next_ns = nxt
+        ex.call_at(nxt, self)
+        timer.callback()
+
+
 class Timer:
     """Calls ``callback()`` every ``period`` of clock time, without drift."""
 
@@ -147,28 +172,15 @@ class Timer:
         self._executor = node.context.executor
         self._generation = 0
         self.cancelled = False
-        self._schedule(self._executor.now_ns + period_ns)
+        self._start(self._executor.now_ns + period_ns)
 
     @property
     def timer_period_ns(self) -> int:
         return self.period_ns
 
-    def _schedule(self, t_ns: int) -> None:
-        gen = self._generation
+    def _start(self, t_ns: int) -> None:
         self._next_ns = t_ns
-
-        def fire() -> None:
-            if self.cancelled or gen != self._generation:
-                return
-            nxt = self._next_ns + self.period_ns
-            now = self._executor.now_ns
-            if nxt <= now:  # the clock jumped past whole periods: skip them, as rcl does
-                nxt += ((now - nxt) // self.period_ns + 1) * self.period_ns
-            self._schedule(nxt)
-            self.callback()
-
-        fire.__self__ = self  # type: ignore[attr-defined]  # lets errors name the owner
-        self._executor.call_at(t_ns, fire)
+        self._executor.call_at(t_ns, _TimerFire(self))
 
     def cancel(self) -> None:
         self.cancelled = True
@@ -178,7 +190,7 @@ class Timer:
         """Restart the period from now (and un-cancel), as rclpy Timer.reset."""
         self.cancelled = False
         self._generation += 1
-        self._schedule(self._executor.now_ns + self.period_ns)
+        self._start(self._executor.now_ns + self.period_ns)
 
     def is_canceled(self) -> bool:
         return self.cancelled

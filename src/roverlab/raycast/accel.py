@@ -8,8 +8,9 @@ tests only the listed primitives; it stops in the first cell whose exit distance
 smaller than the best hit so far, so the answer equals a brute-force test of every
 primitive.
 
-The primitive tests (:func:`segment_hit`, :func:`circle_hit`) and the grid walk helpers are
-compiled with numba and shared by the lidar and camera kernels.
+The primitive tests (:func:`segment_hit`, :func:`segment_distance`, :func:`circle_hit`)
+and the grid-entry helper :func:`grid_entry` are compiled with numba and shared by the lidar
+and camera kernels.
 """
 
 from __future__ import annotations
@@ -31,6 +32,7 @@ __all__ = [
     "circle_hit",
     "grid_entry",
     "scene_grid",
+    "segment_distance",
     "segment_hit",
 ]
 
@@ -111,6 +113,52 @@ def segment_hit(
     if s < -SEGMENT_PARAM_EPS or s > 1.0 + SEGMENT_PARAM_EPS:
         return math.inf, 0.0
     return t, min(1.0, max(0.0, s))
+
+
+@_jit
+def segment_distance(
+    ox: float,
+    oy: float,
+    dx: float,
+    dy: float,
+    x0: float,
+    y0: float,
+    x1: float,
+    y1: float,
+    best: float,
+) -> float:
+    """:func:`segment_hit`'s distance if it is smaller than ``best``, else ``inf``.
+
+    The lidar's inner test: it compares numerators against the determinant and divides
+    only for an accepted hit (same result as ``segment_hit(...)[0]``).
+    """
+    ex = x1 - x0
+    ey = y1 - y0
+    wx = x0 - ox
+    wy = y0 - oy
+    den = dx * ey - dy * ex
+    nt = wx * ey - wy * ex  # t = nt / den
+    ns = wx * dy - wy * dx  # s = ns / den
+    if den > 0.0:
+        if (
+            nt < 0.0
+            or nt >= best * den
+            or ns < -SEGMENT_PARAM_EPS * den
+            or ns > (1.0 + SEGMENT_PARAM_EPS) * den
+        ):
+            return math.inf
+        return nt / den
+    if den < 0.0:
+        if (
+            nt > 0.0
+            or nt <= best * den
+            or ns > -SEGMENT_PARAM_EPS * den
+            or ns < (1.0 + SEGMENT_PARAM_EPS) * den
+        ):
+            return math.inf
+        return nt / den
+    t, _ = segment_hit(ox, oy, dx, dy, x0, y0, x1, y1)
+    return t if t < best else math.inf
 
 
 @_jit

@@ -20,7 +20,7 @@ import numba
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from roverlab.raycast.accel import Grid, circle_hit, grid_entry, scene_grid, segment_hit
+from roverlab.raycast.accel import Grid, circle_hit, grid_entry, scene_grid, segment_distance
 from roverlab.raycast.errors import RaycastInputError
 from roverlab.raycast.scene import Scene
 
@@ -73,8 +73,8 @@ def _cast_ray(
             if it < nseg:
                 if z < segz[it, 0] or z > segz[it, 1]:
                     continue
-                t, _ = segment_hit(
-                    ox, oy, dx, dy, segs[it, 0], segs[it, 1], segs[it, 2], segs[it, 3]
+                t = segment_distance(
+                    ox, oy, dx, dy, segs[it, 0], segs[it, 1], segs[it, 2], segs[it, 3], best
                 )
             else:
                 j = it - nseg

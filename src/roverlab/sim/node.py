@@ -16,7 +16,7 @@ import numpy as np
 from roverlab.core import Node
 from roverlab.geometry import Transform3, quat_from_yaw, rpy_from_quat, wrap_angle
 from roverlab.msgs import classes as mc
-from roverlab.msgs import make_scan, xyz_to_pointcloud2
+from roverlab.msgs import xyz_to_pointcloud2
 from roverlab.raycast import Scene
 from roverlab.raycast.camera import camera_intrinsics, depth_to_points
 from roverlab.sim.collision import Obstacles, inner_radius
@@ -347,19 +347,23 @@ class SimulatorNode(Node):
         p = sensor.params
         scan_time = 1.0 / sensor.update_rate_hz
 
+        empty = np.zeros(0, dtype=np.float32)
+
         def tick() -> None:
             x, y, z, yaw, _ = self.sensor_pose(sensor.mount)
             ranges = model.scan(self.scene, x, y, z, yaw)
             pub.publish(
-                make_scan(
-                    ranges,
+                mc.LaserScan(
+                    header=_header(self.get_clock().now_ns(), sensor.frame_id),
                     angle_min=p.min_angle,
                     angle_max=p.max_angle,
+                    angle_increment=p.angle_increment,
+                    time_increment=0.0,
+                    scan_time=scan_time,
                     range_min=p.range_min,
                     range_max=p.range_max,
-                    frame_id=sensor.frame_id,
-                    stamp=self.get_clock().now_ns(),
-                    scan_time=scan_time,
+                    ranges=ranges,
+                    intensities=empty,
                 )
             )
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 from numpy.typing import NDArray
 
@@ -75,20 +76,40 @@ class LidarModel:
 
     def scan(self, scene: Scene, x: float, y: float, z: float, yaw: float) -> NDArray[np.float32]:
         p = self.params
-        exact = cast_2d(scene, x, y, z, self._rel + yaw, p.range_max)
-        ranges = exact.copy()
-        hit = np.isfinite(ranges)
-        if p.noise_stddev > 0 or p.noise_mean != 0:
-            ranges[hit] += (
-                self.rng.normal(p.noise_mean, p.noise_stddev, int(hit.sum()))
-                if p.noise_stddev > 0
-                else p.noise_mean
-            )
-        if p.range_resolution > 0:
-            ranges[hit] = np.round(ranges[hit] / p.range_resolution) * p.range_resolution
-        ranges[hit & (ranges > p.range_max)] = np.inf
-        ranges[hit & (ranges < p.range_min)] = -np.inf
-        return ranges.astype(np.float32)
+        ranges = cast_2d(scene, x, y, z, self._rel + yaw, p.range_max)
+        noise = (
+            self.rng.normal(p.noise_mean, p.noise_stddev, ranges.shape)
+            if p.noise_stddev > 0
+            else np.full(ranges.shape, p.noise_mean)
+        )
+        return _finish_scan(ranges, noise, p.range_min, p.range_max, p.range_resolution)
+
+
+@numba.njit(cache=True, nogil=True)
+def _finish_scan(
+    exact: NDArray[np.float64],
+    noise: NDArray[np.float64],
+    range_min: float,
+    range_max: float,
+    resolution: float,
+) -> NDArray[np.float32]:
+    """Noise, quantisation and REP 117 infinities on exact ranges, in one pass."""
+    out = np.empty(exact.shape[0], dtype=np.float32)
+    for i in range(exact.shape[0]):
+        r = exact[i]
+        if not math.isfinite(r):
+            out[i] = np.inf
+            continue
+        r += noise[i]
+        if resolution > 0.0:
+            r = round(r / resolution) * resolution
+        if r > range_max:
+            out[i] = np.inf
+        elif r < range_min:
+            out[i] = -np.inf
+        else:
+            out[i] = r
+    return out
 
 
 @dataclass(frozen=True, slots=True)
@@ -157,13 +178,16 @@ class ImuModel:
         z = self._normals()
         rn, an, g = self.rate_noise, self.accel_noise, self.gaussian_noise
         rb, ab = self._rate_bias, self._accel_bias
-        gyro = tuple(
-            true + rb[i] + rn.mean + rn.stddev * z[i] + g * z[6 + i]
-            for i, true in enumerate((0.0, 0.0, w))
+        rm, rs, am, as_ = rn.mean, rn.stddev, an.mean, an.stddev
+        gyro = (
+            rb[0] + rm + rs * z[0] + g * z[6],
+            rb[1] + rm + rs * z[1] + g * z[7],
+            w + rb[2] + rm + rs * z[2] + g * z[8],
         )
-        acc = tuple(
-            true + ab[i] + an.mean + an.stddev * z[3 + i] + g * z[9 + i]
-            for i, true in enumerate((dv_dt, v * w, GRAVITY))
+        acc = (
+            dv_dt + ab[0] + am + as_ * z[3] + g * z[9],
+            v * w + ab[1] + am + as_ * z[4] + g * z[10],
+            GRAVITY + ab[2] + am + as_ * z[5] + g * z[11],
         )
         return (0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2)), gyro, acc
 
