@@ -159,10 +159,48 @@ class Executor:
         try:
             fn()
         except Exception as err:  # a node's bug must not stop the others
-            self.callback_errors += 1
-            if self.on_error is not None:
-                self.on_error(getattr(fn, "__self__", fn), err)
+            self._report(fn, err)
         self.events_run += 1
+
+    def _report(self, fn: Callable[[], Any], err: Exception) -> None:
+        self.callback_errors += 1
+        if self.on_error is not None:
+            self.on_error(getattr(fn, "__self__", fn), err)
+
+    def _spin_sim(self, limit: int) -> None:
+        """The ``sim`` mode's loop without stop conditions: the hot path of simulation."""
+        heap = self._heap
+        ready = self._ready
+        inbox = self._inbox
+        pop = heapq.heappop
+        popleft = ready.popleft
+        count = 0
+        try:
+            while not self._stopped:
+                if inbox:
+                    self._drain_inbox()
+                    heap = self._heap
+                    continue
+                if ready:
+                    if heap and heap[0][0] <= self.now_ns and heap[0][1] < ready[0][0]:
+                        fn = pop(heap)[2]
+                    else:
+                        fn = popleft()[1]
+                elif heap and heap[0][0] <= limit:
+                    t, _, fn = pop(heap)
+                    if t > self.now_ns:
+                        self.now_ns = t
+                else:
+                    if limit != _INF and limit > self.now_ns:
+                        self.now_ns = limit
+                    return
+                try:
+                    fn()
+                except Exception as err:  # a node's bug must not stop the others
+                    self._report(fn, err)
+                count += 1
+        finally:
+            self.events_run += count
 
     def _drain_inbox(self) -> None:
         inbox = self._inbox
@@ -198,6 +236,9 @@ class Executor:
         start_events = self.events_run
         sim = self.mode is ClockMode.SIM
         try:
+            if sim and stop_when is None and max_events is None:
+                self._spin_sim(limit)
+                return
             while not self._stopped:
                 if stop_when is not None and stop_when():
                     return

@@ -25,6 +25,8 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
+import numpy as np
+
 from roverlab.core import Context, Duration, Node, ParameterError, QoSProfile, Time
 from roverlab.description.errors import DescriptionError
 from roverlab.description.model import Joint, JointType, RobotModel
@@ -105,7 +107,8 @@ class RobotStatePublisher(Node):
             if j.mimic is not None:
                 self._mimics.setdefault(j.mimic.joint, []).append(j)
         self._positions: dict[str, float] = {}
-        self._last_published: dict[str, Time] = {}
+        self._last_published: dict[str, int] = {}
+        self._executor = context.executor
         self.publish_fixed_transforms()
         self.create_subscription(JointState, "joint_states", self._on_joint_states, 10)
 
@@ -125,36 +128,40 @@ class RobotStatePublisher(Node):
             self._tf_static.send_transform(msgs)
 
     def _on_joint_states(self, msg: mc.JointState) -> None:
-        names = list(msg.name)
-        positions = list(msg.position)
+        names = msg.name
+        positions = msg.position
         if len(names) != len(positions):
             self.get_logger().warning(
                 f"joint_states message has {len(names)} names but {len(positions)} positions; "
                 "ignored"
             )
             return
-        stamp = Time.from_msg(msg.header.stamp)
-        now = self.get_clock().now()
-        if self.ignore_timestamp or stamp.nanoseconds == 0:
-            stamp = now
-        last = now
+        stamp_ns = msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
+        now_ns = self._executor.now_ns
+        if self.ignore_timestamp or stamp_ns == 0:
+            stamp_ns = now_ns
+        # ROS 1 throttling: publish when the oldest of these joints was last published at
+        # least one publish interval ago
+        last_ns = now_ns
         for name in names:
-            t = self._last_published.get(name, Time(0))
-            last = t if t < last else last
-        if not (self.ignore_timestamp or stamp >= last + self.publish_interval):
+            t = self._last_published.get(name, 0)
+            if t < last_ns:
+                last_ns = t
+        if not (self.ignore_timestamp or stamp_ns >= last_ns + self.publish_interval.nanoseconds):
             return
         updated: dict[str, Joint] = {}
-        for name, position in zip(names, positions, strict=True):
+        for name, position in zip(names, np.asarray(positions, dtype=float).tolist(), strict=True):
             joint = self._movable.get(name)
             if joint is None or joint.mimic is not None:
                 continue
-            self._positions[name] = float(position)
+            self._positions[name] = position
             updated[name] = joint
             for mimic in self._mimics.get(name, ()):
                 updated[mimic.name] = mimic
         for name in names:
-            self._last_published[name] = stamp
+            self._last_published[name] = stamp_ns
         if updated:
+            stamp = Time(stamp_ns)
             self._tf.send_transform(
                 [
                     self._msg(j, stamp, self.model.joint_position(j, self._positions))

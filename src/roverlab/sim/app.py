@@ -7,7 +7,7 @@ What ``roslaunch gazebo_ros empty_world.launch world_name:=...`` plus ``spawn_mo
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from roverlab.core import Context
@@ -57,6 +57,8 @@ class Simulation:
         spawn: the robot's start pose in the world.
         seed: seed of every random draw.
         robot_args: xacro arguments (``name:=value`` on the command line).
+        cameras: simulate the robot's cameras and depth cameras (rendering is by far
+            the most expensive sensor; switch it off for fast batch runs).
     """
 
     context: Context
@@ -65,6 +67,7 @@ class Simulation:
     spawn: SpawnPose = field(default_factory=SpawnPose)
     seed: int = 0
     robot_args: dict[str, str] = field(default_factory=dict)
+    cameras: bool = True
 
     def __post_init__(self) -> None:
         for v in (self.spawn.x, self.spawn.y, self.spawn.yaw):
@@ -77,6 +80,8 @@ class Simulation:
             path = resolve_robot(str(self.robot))
             self.robot_model = load_robot(path, args=self.robot_args)
         self.config = sim_config_from_model(self.robot_model)
+        if not self.cameras:
+            self.config = replace(self.config, cameras=(), depth_cameras=())
         self.scene = self.world_model.to_scene()
         self.simulator = SimulatorNode(
             context=self.context,

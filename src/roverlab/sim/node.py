@@ -146,6 +146,7 @@ class SimulatorNode(Node):
         self._state = np.zeros(STATE_SIZE)
         self._state[S_X], self._state[S_Y] = spawn.x, spawn.y
         self._state[S_TH] = float(wrap_angle(spawn.yaw))
+        self._executor = context.executor
         self._step_ns = round(1e9 / self.physics_rate)
         self._physics_ns = self.get_clock().now_ns()
         self._slip_block = 1 << 14
@@ -221,10 +222,10 @@ class SimulatorNode(Node):
 
     def advance(self) -> None:
         """Run every physics step up to the current clock time."""
-        now = self.get_clock().now_ns()
-        steps = (now - self._physics_ns) // self._step_ns
-        if steps <= 0:
+        now = self._executor.now_ns
+        if now < self._physics_ns + self._step_ns:
             return
+        steps = (now - self._physics_ns) // self._step_ns
         self._physics_ns += steps * self._step_ns
         if self.drive is None:
             return
@@ -375,12 +376,16 @@ class SimulatorNode(Node):
         rate = sensor.update_rate_hz if sensor.update_rate_hz > 0 else self.physics_rate
         cov = np.zeros(9)
 
+        ex = self._executor
+        frame = sensor.frame_id
+
         def tick() -> None:
             self.advance()
-            q, gyro, acc = model.measure(self.yaw, self.v, self.w, float(self._state[S_DV]))
+            st = self._state.tolist()
+            q, gyro, acc = model.measure(st[S_TH], st[S_V], st[S_W], st[S_DV])
             pub.publish(
                 mc.Imu(
-                    header=_header(self.get_clock().now_ns(), sensor.frame_id),
+                    header=_header(ex.now_ns, frame),
                     orientation=mc.Quaternion(x=q[0], y=q[1], z=q[2], w=q[3]),
                     orientation_covariance=cov,
                     angular_velocity=mc.Vector3(x=gyro[0], y=gyro[1], z=gyro[2]),
