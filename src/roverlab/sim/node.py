@@ -294,11 +294,11 @@ class SimulatorNode(Node):
         if self.joint_pub is not None:
             self.joint_pub.publish(
                 mc.JointState(
-                    header=_header(ns, ""),
-                    name=[d.left_joint, d.right_joint],
-                    position=np.array([st[S_AL], st[S_AR]]),
-                    velocity=np.array([st[S_VL], st[S_VR]]) * (2.0 / d.params.wheel_diameter_m),
-                    effort=np.zeros(2),
+                    _header(ns, ""),
+                    [d.left_joint, d.right_joint],
+                    np.array([st[S_AL], st[S_AR]]),
+                    np.array([st[S_VL], st[S_VR]]) * (2.0 / d.params.wheel_diameter_m),
+                    np.zeros(2),
                 )
             )
 

@@ -49,12 +49,14 @@ def transform_to_msg(parent: str, child: str, stamp: Time, transform: Transform3
     sec, nanosec = divmod(stamp.nanoseconds, _NS)
     tx, ty, tz = transform.translation
     qx, qy, qz, qw = transform.rotation
+    # positional, in ROS field order: robot_state_publisher and broadcasters call this
+    # for every transform, and keyword construction costs twice as much
     return mc.TransformStamped(
-        header=mc.Header(stamp=mc.Time(sec=sec, nanosec=nanosec), frame_id=parent),
-        child_frame_id=child,
-        transform=mc.Transform(
-            translation=mc.Vector3(x=float(tx), y=float(ty), z=float(tz)),
-            rotation=mc.Quaternion(x=float(qx), y=float(qy), z=float(qz), w=float(qw)),
+        mc.Header(mc.Time(sec, nanosec), parent),
+        child,
+        mc.Transform(
+            mc.Vector3(float(tx), float(ty), float(tz)),
+            mc.Quaternion(float(qx), float(qy), float(qz), float(qw)),
         ),
     )
 
