@@ -103,9 +103,9 @@ def test_world_odometry_equals_ground_truth_and_tf() -> None:
 def _drive_square(seed: int, slip: float) -> tuple[float, float, Any, Any]:
     """Open-loop 1 m square; returns (truth closure error, encoder closure error, ...)."""
     ctx = Context()
-    sim = Simulation(context=ctx, world="empty", robot="mybot", seed=seed)
-    sim.simulator.wheel_slip = slip
-    sim.simulator._params[3] = slip
+    sim = Simulation(
+        context=ctx, world="empty", robot="mybot", seed=seed, parameters={"wheel_slip": slip}
+    )
     cmd = ctx.create_node("driver").create_publisher(Twist, "/cmd_vel", 1)
     start = (sim.simulator.x, sim.simulator.y)
     for _ in range(4):
@@ -228,3 +228,22 @@ def test_bad_robot_and_spawn_are_one_clear_error() -> None:
         Simulation(context=Context(), world="empty", robot="rover9")
     with pytest.raises(SimulationError, match="finite"):
         Simulation(context=Context(), world="empty", spawn=SpawnPose(float("nan"), 0, 0))
+
+
+def test_nan_and_huge_commands_are_contained() -> None:
+    ctx = Context()
+    sim = Simulation(context=ctx, world="empty", robot="mybot", cameras=False)
+    cmd = ctx.create_node("driver").create_publisher(Twist, "/cmd_vel", 1)
+    cmd.publish(Twist(linear_x=float("nan"), angular_z=0.5))
+    ctx.spin_for(1.0)
+    assert (sim.simulator.x, sim.simulator.y, sim.simulator.yaw) == (0.0, 0.0, 0.0)
+    cmd.publish(Twist(linear_x=1e12))
+    ctx.spin_for(1.0)
+    # wheel speeds are clamped: at most 5 m/s, never inf or NaN
+    assert 0.0 < sim.simulator.x <= 5.0 + 1e-9
+    assert math.isfinite(sim.simulator.y) and math.isfinite(sim.simulator.yaw)
+
+
+def test_bad_simulator_parameter_is_one_clear_error() -> None:
+    with pytest.raises(ValueError, match="slip_stddev"):
+        Simulation(context=Context(), world="empty", parameters={"wheel_slip": -1.0})

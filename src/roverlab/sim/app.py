@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import Any
 
 from roverlab.core import Context
 from roverlab.description import RobotModel, find_package, load_robot
@@ -59,6 +60,8 @@ class Simulation:
         robot_args: xacro arguments (``name:=value`` on the command line).
         cameras: simulate the robot's cameras and depth cameras (rendering is by far
             the most expensive sensor; switch it off for fast batch runs).
+        parameters: parameters of the ``gazebo`` node (``physics_rate``, ``wheel_slip``,
+            ``ground_truth_rate``, ...), as ``<param>`` lines in a launch file.
     """
 
     context: Context
@@ -68,6 +71,7 @@ class Simulation:
     seed: int = 0
     robot_args: dict[str, str] = field(default_factory=dict)
     cameras: bool = True
+    parameters: dict[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         for v in (self.spawn.x, self.spawn.y, self.spawn.yaw):
@@ -89,6 +93,7 @@ class Simulation:
             robot=self.config,
             spawn=self.spawn,
             seed=self.seed,
+            parameter_overrides=self.parameters,
         )
         self.state_publisher = RobotStatePublisher(
             context=self.context, robot_description=self.robot_model

@@ -8,7 +8,7 @@ generator spawned from the ``seed`` parameter, so a seeded run is reproducible.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -41,6 +41,7 @@ from roverlab.sim.dynamics import (
     STATE_SIZE,
     advance,
 )
+from roverlab.sim.physics import DiffDriveParams
 from roverlab.sim.sensors import CameraModel, ImuModel, LidarModel
 from roverlab.tf import TransformBroadcaster
 
@@ -158,12 +159,14 @@ class SimulatorNode(Node):
         # drive
         self.drive = robot.drive
         d = self.drive
+        # the node's wheel_slip parameter sets the drive's slip (DiffDriveParams validates)
+        p = replace(d.params if d else DiffDriveParams(1.0, 1.0), slip_stddev=self.wheel_slip)
         self._params = np.array(
             [
-                d.params.wheel_separation_m if d else 1.0,
-                d.params.wheel_diameter_m if d else 1.0,
-                d.params.wheel_acceleration if d else 0.0,
-                self.wheel_slip,
+                p.wheel_separation_m,
+                p.wheel_diameter_m,
+                p.wheel_acceleration,
+                p.slip_stddev,
                 inner_radius(self._footprint),
             ]
         )

@@ -29,7 +29,8 @@ class DiffDriveParams:
         wheel_acceleration: max change of wheel surface speed, m/s^2 (0 = unlimited).
         max_wheel_speed_mps: clamp of each wheel's surface speed (from ``wheelTorque`` we
             cannot derive one; this guards against absurd commands).
-        slip_stddev: relative 1-sigma slip of each wheel per step (0 = no slip).
+        slip_stddev: relative 1-sigma slip of each wheel per physics step (0 = no slip;
+            the simulator node's ``wheel_slip`` parameter sets it).
     """
 
     wheel_separation_m: float
