@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from roverlab.cli import daemon, demo, graph, sim, tf, topic
+from roverlab.cli import daemon, demo, graph, launch, sim, tf, topic
 from roverlab.cli.common import NetworkOptions
 from roverlab.description import cli as urdf_cli
 from roverlab.errors import RoverlabError
@@ -27,6 +27,7 @@ app.add_typer(tf.app, name="tf")
 app.add_typer(daemon.app, name="daemon")
 app.command("demo")(demo.demo)
 app.command("sim")(sim.sim)
+app.command("launch")(launch.launch)
 app.add_typer(urdf_cli.app, name="urdf")
 app.command("teleop")(teleop_cli.teleop)
 

@@ -412,6 +412,15 @@ class Node:
         hint = f" (did you mean '{near[0]}'?)" if near else ""
         return f"node '{self._name}' has no parameter '{name}'{hint}"
 
+    def unused_parameter_overrides(self) -> list[str]:
+        """Overrides (from a launch file or YAML) that name no declared parameter."""
+        return [name for name in self._overrides if name not in self._parameters]
+
+    def discard_parameter_overrides(self, names: Iterable[str]) -> None:
+        """Forget overrides, e.g. ROS parameters a roverlab node does not implement."""
+        for name in names:
+            self._overrides.pop(name, None)
+
     def check_parameter_overrides(self) -> None:
         """Raise ParameterError for an override that names no declared parameter."""
         for name in self._overrides:

@@ -1,0 +1,87 @@
+"""``roverlab launch``: run a roslaunch ``.launch`` file with roverlab's nodes."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from roverlab.bag import McapRecorder
+from roverlab.cli.common import network_options, run_context
+from roverlab.cli.sim import parse_rate
+from roverlab.core import Context, configure_logging
+from roverlab.core.transport.zenoh import ZenohTransport
+from roverlab.description import find_package
+from roverlab.launch import LaunchError, build_launch
+
+
+def _resolve(target: list[str]) -> tuple[Path, dict[str, str]]:
+    """``PKG FILE`` or ``PATH``, followed by ``name:=value`` arguments (as roslaunch)."""
+    plain = [t for t in target if ":=" not in t]
+    args = dict(t.split(":=", 1) for t in target if ":=" in t)
+    if len(plain) == 1:
+        return Path(plain[0]), args
+    if len(plain) == 2:
+        pkg_dir = find_package(plain[0])
+        matches = sorted(pkg_dir.rglob(plain[1]))
+        if not matches:
+            raise LaunchError(
+                f"launch file {plain[1]!r} not found in package {plain[0]} ({pkg_dir})"
+            )
+        return matches[0], args
+    raise LaunchError("usage: roverlab launch PKG FILE.launch [name:=value ...] or PATH.launch")
+
+
+def launch(
+    ctx: typer.Context,
+    target: Annotated[
+        list[str],
+        typer.Argument(
+            metavar="[PKG] FILE [name:=value ...]", help="A package and launch file, or a path."
+        ),
+    ],
+    rate: Annotated[
+        str, typer.Option("--rate", help="Sim seconds per wall second, or 'max'.")
+    ] = "1",
+    duration: Annotated[
+        float | None, typer.Option("--duration", help="Stop after this many sim seconds.")
+    ] = None,
+    seed: Annotated[int, typer.Option("--seed", help="Seed of every random draw.")] = 0,
+    record: Annotated[
+        Path | None, typer.Option("--record", help="Record every topic to this MCAP file.")
+    ] = None,
+    expose: Annotated[
+        bool,
+        typer.Option("--expose/--no-expose", help="Make the topics visible to other processes."),
+    ] = True,
+) -> None:
+    """Run a .launch file (roslaunch): its nodes, its Gazebo world and spawned robot."""
+    path, args = _resolve(target)
+    pace = parse_rate(rate)
+    configure_logging()
+    context = Context(
+        clock="sim" if math.isinf(pace) else "paced", rate=1.0 if math.isinf(pace) else pace
+    )
+    recorder = None
+    try:
+        if record is not None:
+            recorder = McapRecorder(record)
+            context.add_transport(recorder)
+        started = build_launch(path, args, context=context, seed=seed)
+        if expose:
+            context.add_transport(ZenohTransport(network_options(ctx).zenoh_options()))
+    except BaseException:
+        if recorder is not None:
+            recorder.abort()
+        context.shutdown()
+        raise
+    for warning in started.warnings:
+        typer.echo(f"warning: {warning}", err=True)
+    names = ", ".join(n.get_fully_qualified_name() for n in started.nodes)
+    typer.echo(f"started {len(started.nodes)} nodes: {names}", err=True)
+    wall = run_context(context, duration)
+    typer.echo(
+        f"launch stopped after {context.now().seconds:.1f} sim s ({wall:.1f} s wall)", err=True
+    )

@@ -1,0 +1,259 @@
+"""ROS ``(pkg, type)`` -> roverlab node factories: what a ``<node>`` line starts.
+
+Plugins from other packages register through the ``roverlab.nodes`` entry-point group
+(``"pkg/type" = "module:factory"``); a duplicate registration is an error.
+"""
+
+from __future__ import annotations
+
+import math
+import shlex
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from importlib.metadata import entry_points
+from pathlib import Path
+from typing import Any
+
+from roverlab.core import Context, Node, QoSProfile
+from roverlab.description import load_robot
+from roverlab.description.node import JointStatePublisher, RobotStatePublisher
+from roverlab.geometry import quat_from_rpy
+from roverlab.launch.xml import LaunchError, NodeSpec
+from roverlab.msgs import classes as mc
+from roverlab.world import BUNDLED_WORLDS, load_world
+
+__all__ = ["REGISTRY", "LaunchState", "NodeFactory", "register"]
+
+
+@dataclass
+class LaunchState:
+    """What the nodes of one launch share: the context, global parameters, and the
+    simulation being assembled (gzserver gives the world, spawn_model the robot)."""
+
+    context: Context
+    params: dict[str, Any]
+    world: Any = None
+    world_source: str = ""
+    spawns: list[tuple[Any, tuple[float, float, float], str]] = field(default_factory=list)
+    spawn_urdf: str = ""
+    warnings: list[str] = field(default_factory=list)
+
+
+NodeFactory = Callable[[LaunchState, NodeSpec], Node | None]
+
+REGISTRY: dict[tuple[str, str], NodeFactory] = {}
+
+
+def register(pkg: str, type_: str) -> Callable[[NodeFactory], NodeFactory]:
+    def deco(fn: NodeFactory) -> NodeFactory:
+        key = (pkg, type_)
+        if key in REGISTRY:
+            raise LaunchError(f"node {pkg}/{type_} is registered twice")
+        REGISTRY[key] = fn
+        return fn
+
+    return deco
+
+
+def load_plugins() -> None:
+    """Register the nodes other packages declare in the ``roverlab.nodes`` entry points."""
+    for ep in entry_points(group="roverlab.nodes"):
+        pkg, _, type_ = ep.name.partition("/")
+        register(pkg, type_)(ep.load())
+
+
+def _kwargs(spec: NodeSpec) -> dict[str, Any]:
+    return {
+        "namespace": spec.namespace,
+        "parameter_overrides": spec.params,
+        "remappings": spec.remaps,
+    }
+
+
+def _description(state: LaunchState, spec: NodeSpec) -> str | None:
+    if "robot_description" in spec.params:
+        return str(spec.params.pop("robot_description"))
+    glob = spec.namespace.rstrip("/") + "/robot_description"
+    return str(state.params[glob]) if glob in state.params else None
+
+
+class DescriptionWaiter(Node):
+    """Starts a node once ``/robot_description`` arrives, for launch files that rely on a
+    parameter set by another launch (ROS 1's global parameter server): in roverlab the
+    description travels on the latched ``/robot_description`` topic, as in ROS 2."""
+
+    def __init__(self, state: LaunchState, spec: NodeSpec, make: Callable[[str], Node]) -> None:
+        super().__init__(f"{spec.name}_waiting_for_robot_description", context=state.context)
+        self.started: Node | None = None
+        self._make = make
+        self.get_logger().info(f"{spec.name}: waiting for /robot_description")
+        self.create_subscription(
+            mc.String,
+            "/robot_description",
+            self._on_description,
+            QoSProfile(depth=1, durability="transient_local"),
+        )
+
+    def _on_description(self, msg: Any) -> None:
+        if self.started is None:
+            self.started = self._make(str(msg.data))
+
+
+def _with_description(make: Callable[[LaunchState, NodeSpec, str], Node]) -> NodeFactory:
+    def factory(state: LaunchState, spec: NodeSpec) -> Node:
+        urdf = _description(state, spec)
+        if urdf is None:
+            return DescriptionWaiter(state, spec, lambda text: make(state, spec, text))
+        return make(state, spec, urdf)
+
+    return factory
+
+
+def _make_rsp(state: LaunchState, spec: NodeSpec, urdf: str) -> Node:
+    return RobotStatePublisher(
+        state.context, robot_description=urdf, node_name=spec.name, **_kwargs(spec)
+    )
+
+
+def _make_jsp(state: LaunchState, spec: NodeSpec, urdf: str) -> Node:
+    return JointStatePublisher(
+        state.context, robot_description=urdf, node_name=spec.name, **_kwargs(spec)
+    )
+
+
+for _key in (
+    ("robot_state_publisher", "robot_state_publisher"),
+    ("robot_state_publisher", "state_publisher"),
+):
+    REGISTRY[_key] = _with_description(_make_rsp)
+for _key in (
+    ("joint_state_publisher", "joint_state_publisher"),
+    ("joint_state_publisher_gui", "joint_state_publisher_gui"),
+):
+    REGISTRY[_key] = _with_description(_make_jsp)
+
+
+class StaticTransformPublisher(Node):
+    """tf2_ros static_transform_publisher: ``x y z yaw pitch roll frame child`` or
+    ``x y z qx qy qz qw frame child`` (ROS 1 order), latched on ``/tf_static``."""
+
+    def __init__(self, context: Context, *, args: str, source: str, **kwargs: Any) -> None:
+        super().__init__(
+            kwargs.pop("node_name", "static_transform_publisher"), context=context, **kwargs
+        )
+        parts = shlex.split(args)
+        if len(parts) in (9, 10):  # ROS 1 tf's trailing period in ms
+            parts = parts[:8] if len(parts) == 9 else parts[:9]
+        if len(parts) not in (8, 9):
+            raise LaunchError(
+                f"{source}: static_transform_publisher needs 'x y z yaw pitch roll frame child' "
+                f"or 'x y z qx qy qz qw frame child', got {args!r}"
+            )
+        try:
+            nums = [float(v) for v in parts[:-2]]
+        except ValueError as err:
+            raise LaunchError(f"{source}: static_transform_publisher: {err}") from err
+        if not all(math.isfinite(v) for v in nums):
+            raise LaunchError(f"{source}: static_transform_publisher: values must be finite")
+        parent, child = parts[-2].lstrip("/"), parts[-1].lstrip("/")
+        x, y, z = nums[:3]
+        if len(nums) == 6:
+            yaw, pitch, roll = nums[3:]
+            q = [float(v) for v in quat_from_rpy(roll, pitch, yaw)]
+        else:
+            q = nums[3:]
+        pub = self.create_publisher(
+            mc.TFMessage, "/tf_static", QoSProfile(depth=1, durability="transient_local")
+        )
+        stamp = self.get_clock().now().to_msg()
+        pub.publish(
+            mc.TFMessage(
+                [
+                    mc.TransformStamped(
+                        mc.Header(stamp, parent),
+                        child,
+                        mc.Transform(
+                            mc.Vector3(x, y, z),
+                            mc.Quaternion(float(q[0]), float(q[1]), float(q[2]), float(q[3])),
+                        ),
+                    )
+                ]
+            )
+        )
+
+
+def _static_tf(state: LaunchState, spec: NodeSpec) -> Node:
+    return StaticTransformPublisher(
+        state.context, args=spec.args, source=spec.source, node_name=spec.name, **_kwargs(spec)
+    )
+
+
+REGISTRY[("tf2_ros", "static_transform_publisher")] = _static_tf
+REGISTRY[("tf", "static_transform_publisher")] = _static_tf
+
+
+@register("gazebo_ros", "gzserver")
+def _gzserver(state: LaunchState, spec: NodeSpec) -> None:
+    world = shlex.split(spec.args)[-1] if spec.args.strip() else "empty"
+    # Gazebo's own worlds ("worlds/empty.world") resolve to roverlab's bundled ones
+    if not Path(world).is_file() and Path(world).stem in BUNDLED_WORLDS:
+        world = Path(world).stem
+    state.world = load_world(world)
+    state.world_source = spec.source
+    return None
+
+
+@register("gazebo_ros", "spawn_model")
+def _spawn(state: LaunchState, spec: NodeSpec) -> None:
+    argv = shlex.split(spec.args)
+    opts: dict[str, str] = {}
+    flags: set[str] = set()
+    i = 0
+    while i < len(argv):
+        a = argv[i]
+        if a in ("-urdf", "-sdf", "-gazebo", "-unpause", "-wait"):
+            flags.add(a)
+            i += 1
+        elif a.startswith("-") and i + 1 < len(argv):
+            opts[a] = argv[i + 1]
+            i += 2
+        else:
+            raise LaunchError(f"{spec.source}: spawn_model: unexpected argument {a!r}")
+    if "-sdf" in flags:
+        raise LaunchError(f"{spec.source}: spawn_model -sdf is not supported; use -urdf")
+    if "-param" in opts:
+        key = opts["-param"]
+        full = key if key.startswith("/") else spec.namespace.rstrip("/") + "/" + key
+        if full not in state.params:
+            raise LaunchError(f"{spec.source}: spawn_model: parameter {full} is not set")
+        state.spawn_urdf = str(state.params[full])
+        robot = load_robot(state.spawn_urdf)
+    elif "-file" in opts:
+        robot = load_robot(Path(opts["-file"]))
+        state.spawn_urdf = robot.urdf
+    else:
+        raise LaunchError(f"{spec.source}: spawn_model needs -param NAME or -file PATH")
+    try:
+        pose = (float(opts.get("-x", 0)), float(opts.get("-y", 0)), float(opts.get("-Y", 0)))
+    except ValueError as err:
+        raise LaunchError(f"{spec.source}: spawn_model: {err}") from err
+    state.spawns.append((robot, pose, spec.source))
+    return None
+
+
+def _unavailable(reason: str) -> NodeFactory:
+    def factory(state: LaunchState, spec: NodeSpec) -> None:
+        state.warnings.append(f"{spec.source}: {spec.pkg}/{spec.type} not started: {reason}")
+        return None
+
+    return factory
+
+
+REGISTRY[("rviz", "rviz")] = _unavailable("the web dashboard is not part of roverlab yet")
+REGISTRY[("rqt_image_view", "rqt_image_view")] = _unavailable(
+    "the web dashboard is not part of roverlab yet"
+)
+for _t in ("teleop_twist_keyboard.py", "teleop_twist_keyboard"):
+    REGISTRY[("teleop_twist_keyboard", _t)] = _unavailable(
+        "it needs a terminal: run `roverlab teleop` in one"
+    )
