@@ -175,3 +175,33 @@ def test_cli_launch_with_args_and_record(tmp_path: Path) -> None:
         bad.stderr.strip().splitlines() == [bad.stderr.strip().splitlines()[0]]
         and "not found in package mycar" in bad.stderr
     )
+
+
+def test_map_server_node_from_a_launch_file(tmp_path: Path) -> None:
+    import numpy as np
+
+    from roverlab.maps import save_map
+
+    grid = np.full((20, 30), -1, dtype=np.int8)
+    grid[5:15, 5:25] = 0
+    grid[10, 5:25] = 100
+    save_map(tmp_path / "room", grid, resolution=0.1, origin=(-1.0, -2.0, 0.0))
+    launch_file = _write(
+        tmp_path,
+        "nav.launch",
+        f"""<launch>
+  <arg name="map_file" default="{tmp_path}/room.yaml"/>
+  <node pkg="map_server" name="map_server" type="map_server" args="$(arg map_file)">
+    <param name="frame_id" value="map"/>
+  </node>
+</launch>""",
+    )
+    ctx = Context()
+    build_launch(launch_file, context=ctx)
+    got: list[object] = []
+    ctx.create_node("late").create_subscription("nav_msgs/msg/OccupancyGrid", "/map", got.append, 1)
+    ctx.spin_for(0.1)
+    assert len(got) == 1
+    m = got[0]
+    assert (m.info.width, m.info.height) == (30, 20)  # type: ignore[attr-defined]
+    assert m.info.origin.position.x == pytest.approx(-1.0)  # type: ignore[attr-defined]

@@ -11,6 +11,7 @@ from roverlab.cli import daemon, demo, graph, launch, sim, tf, topic
 from roverlab.cli.common import NetworkOptions
 from roverlab.description import cli as urdf_cli
 from roverlab.errors import RoverlabError
+from roverlab.maps import cli as map_cli
 from roverlab.teleop import cli as teleop_cli
 
 app = typer.Typer(
@@ -29,6 +30,7 @@ app.command("demo")(demo.demo)
 app.command("sim")(sim.sim)
 app.command("launch")(launch.launch)
 app.add_typer(urdf_cli.app, name="urdf")
+app.add_typer(map_cli.app, name="map")
 app.command("teleop")(teleop_cli.teleop)
 
 

@@ -19,6 +19,7 @@ from roverlab.description import load_robot
 from roverlab.description.node import JointStatePublisher, RobotStatePublisher
 from roverlab.geometry import quat_from_rpy
 from roverlab.launch.xml import LaunchError, NodeSpec
+from roverlab.maps.node import MapSaver, MapServer
 from roverlab.msgs import classes as mc
 from roverlab.world import BUNDLED_WORLDS, load_world
 
@@ -239,6 +240,26 @@ def _spawn(state: LaunchState, spec: NodeSpec) -> None:
         raise LaunchError(f"{spec.source}: spawn_model: {err}") from err
     state.spawns.append((robot, pose, spec.source))
     return None
+
+
+@register("map_server", "map_server")
+def _map_server(state: LaunchState, spec: NodeSpec) -> Node:
+    argv = shlex.split(spec.args)
+    if len(argv) != 1:
+        raise LaunchError(f"{spec.source}: map_server takes one argument, the map's YAML file")
+    return MapServer(state.context, yaml_path=argv[0], node_name=spec.name, **_kwargs(spec))
+
+
+@register("map_server", "map_saver")
+def _map_saver(state: LaunchState, spec: NodeSpec) -> Node:
+    argv = shlex.split(spec.args)
+    prefix = "map"
+    if "-f" in argv:
+        i = argv.index("-f")
+        if i + 1 >= len(argv):
+            raise LaunchError(f"{spec.source}: map_saver -f needs a file name")
+        prefix = argv[i + 1]
+    return MapSaver(state.context, path_prefix=prefix, node_name=spec.name, **_kwargs(spec))
 
 
 def _unavailable(reason: str) -> NodeFactory:
