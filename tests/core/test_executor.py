@@ -216,3 +216,17 @@ def test_timer_skips_periods_the_clock_jumped_over() -> None:
     ctx.executor.spin(wall_timeout_s=0.01)
     # one call for the jump to 5.05 s (not 50), then the regular one at 5.1 s
     assert fired == [5_050_000_000, 5_100_000_000]
+
+
+def test_clock_pauses_without_listeners_and_resumes_for_a_late_subscriber() -> None:
+    ctx = Context(clock_period_s=0.01)
+    ctx.spin_for(1.0)
+    runs_idle = ctx.executor.events_run
+    assert runs_idle <= 2  # one tick found nobody listening and paused the timer
+    stamps: list[int] = []
+    ctx.create_node("late").create_subscription(
+        Clock, "/clock", lambda m: stamps.append(m.clock.sec * 10**9 + m.clock.nanosec), 10
+    )
+    ctx.spin_for(1.0)
+    assert 99 <= len(stamps) <= 100
+    assert stamps[0] > 1_000_000_000 and stamps[-1] <= 2_000_000_000

@@ -11,7 +11,7 @@ from roverlab.core.errors import GraphError
 from roverlab.core.executor import ClockMode, Executor
 from roverlab.core.graph import TopicGraph
 from roverlab.core.log import NodeLogger
-from roverlab.core.node import Node, Publisher, Subscription
+from roverlab.core.node import Node, Publisher, Subscription, pausing_timer
 from roverlab.core.qos import QoSProfile
 from roverlab.core.time import Duration, Time
 from roverlab.msgs import classes as mc
@@ -99,10 +99,10 @@ class Context:
         ex = self.executor
 
         def tick() -> None:
-            if pub.has_listeners:  # nobody listening here or elsewhere: nothing to build
-                pub.publish(mc.Clock(clock=Time(ex.now_ns).to_msg()))
+            pub.publish(mc.Clock(clock=Time(ex.now_ns).to_msg()))
 
-        node.create_timer(self._clock_period_s, tick)
+        # /clock pauses while nobody listens here or in another process
+        pausing_timer(node, self._clock_period_s, pub, tick)
         self._clock_node = node
 
     def _start_clock_follower(self) -> None:

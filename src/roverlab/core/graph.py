@@ -80,6 +80,13 @@ class Topic:
     subscriptions: list[Subscription] = field(default_factory=list)
     remote_send: Callable[[Any], None] | None = None
     published: int = 0
+    listener_watchers: list[Callable[[], None]] = field(default_factory=list)
+
+    def notify_listeners(self) -> None:
+        """Someone started listening: wake the publishers that paused (executor thread)."""
+        watchers, self.listener_watchers = self.listener_watchers, []
+        for watcher in watchers:
+            watcher()
 
     def latched_history(self) -> list[Any]:
         """Messages of transient-local publishers, oldest first, for a late subscriber."""

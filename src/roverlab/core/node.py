@@ -93,6 +93,29 @@ class Publisher:
         """
         return bool(self.topic.subscriptions) or self.topic.remote_send is not None
 
+    def when_listened(self, callback: Callable[[], Any]) -> None:
+        """Call ``callback`` (on the executor thread) once someone subscribes here or in
+        another process: lets a publisher stop its timer while nobody listens."""
+        self.topic.listener_watchers.append(callback)
+
+
+def pausing_timer(
+    node: Node, period_s: float, publisher: Publisher, tick: Callable[[], Any]
+) -> Timer:
+    """A timer calling ``tick`` only while ``publisher`` has listeners; it stops while
+    nobody listens and restarts when someone subscribes (in this process or another)."""
+    timer: Timer
+
+    def fire() -> None:
+        if publisher.has_listeners:
+            tick()
+        else:
+            timer.cancel()
+            publisher.when_listened(timer.reset)
+
+    timer = node.create_timer(period_s, fire)
+    return timer
+
     def destroy(self) -> None:
         self.node.destroy_publisher(self)
 
@@ -296,6 +319,8 @@ class Node:
         for msg in t.latched_history():
             sub._enqueue(msg)
         self.context._on_subscription(sub)
+        if t.listener_watchers:
+            t.notify_listeners()
         return sub
 
     def create_timer(self, timer_period_sec: float, callback: Callable[[], Any]) -> Timer:

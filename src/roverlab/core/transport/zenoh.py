@@ -309,6 +309,9 @@ class ZenohTransport:
 
         def on_matching(status: Any) -> None:
             topic.remote_send = send if status.matching else None
+            ctx = self._context
+            if status.matching and ctx is not None and topic.listener_watchers:
+                ctx.executor.call_soon_threadsafe(topic.notify_listeners)
 
         link.publisher = zpub
         link.matching = zpub.declare_matching_listener(on_matching)
