@@ -180,6 +180,8 @@ class _TopicLink:
         self.matching: Any = None
         self.subscriber: Any = None
         self.latched_queryable: Any = None
+        self.latched_watch: Any = None
+        self.remote_latched: dict[str, list[Any]] = {}  # zid -> that process's history
         self.tokens: dict[object, Any] = {}
 
 
@@ -272,7 +274,13 @@ class ZenohTransport:
                         partial(self._on_sample, topic),
                         allowed_origin=zenoh.Locality.REMOTE,
                     )
-                self._fetch_latched(topic, sub)
+                if link.latched_watch is None:
+                    link.latched_watch = self._watch_latched(topic, link)
+                else:
+                    history = [m for msgs in link.remote_latched.values() for m in msgs]
+                    ctx = self._context
+                    if history and ctx is not None:
+                        ctx.executor.call_soon_threadsafe(partial(_enqueue_all, [sub], history))
             else:
                 tok = link.tokens.pop(sub, None)
                 if tok is not None:
@@ -343,21 +351,40 @@ class ZenohTransport:
         for msg in topic.latched_history():
             query.reply(query.key_expr, serialize(msg))
 
-    def _fetch_latched(self, topic: Any, sub: Subscription) -> None:
-        """Ask other processes' latched publishers of this topic for their history."""
-        selector = f"rl/{self.domain}/l/{topic.name.lstrip('/')}/*"
+    def _watch_latched(self, topic: Any, link: _TopicLink) -> Any:
+        """Follow the latched publishers of ``topic`` in other processes: each one that
+        is (or later becomes) alive is asked for its history, which every subscription of
+        the topic receives (and later local subscriptions too)."""
+        pattern = (
+            f"rl/{self.domain}/g/*/p/*/{encode_name(topic.name)}/{encode_name(topic.typename)}"
+            "/latched"
+        )
         ctx = self._context
 
-        def on_reply(reply: Any) -> None:
-            if reply.ok is None or ctx is None:
+        def on_token(sample: Any) -> None:
+            if sample.kind != zenoh.SampleKind.PUT or ctx is None:
                 return
-            try:
-                msg = deserialize(reply.ok.payload.to_bytes(), topic.typename)
-            except Exception:
+            zid = str(sample.key_expr).split("/")[3]
+            if zid == self.zid:
                 return
-            ctx.executor.call_soon_threadsafe(lambda: sub._enqueue(msg))
+            selector = f"rl/{self.domain}/l/{topic.name.lstrip('/')}/{zid}"
+            link.remote_latched[zid] = []
 
-        self.session.get(selector, on_reply, timeout=2.0)
+            def on_reply(reply: Any) -> None:  # never block in Zenoh's callback threads
+                if reply.ok is None:
+                    return
+                try:
+                    msg = deserialize(reply.ok.payload.to_bytes(), topic.typename)
+                except Exception:
+                    return
+                link.remote_latched.setdefault(zid, []).append(msg)
+                ctx.executor.call_soon_threadsafe(
+                    lambda: _enqueue_all(list(topic.subscriptions), [msg])
+                )
+
+            self.session.get(selector, on_reply, timeout=2.0)
+
+        return self.session.liveliness().declare_subscriber(pattern, on_token, history=True)
 
     # ----------------------------------------------------------------- parameters
     def _on_param_query(self, node: Node, query: Any) -> None:
@@ -399,6 +426,12 @@ class ZenohTransport:
                 return {"error": f"node '{node.get_name()}' did not answer (executor busy?)"}
             return result
         return {"error": f"unknown parameter operation {op!r}"}
+
+
+def _enqueue_all(subs: list[Any], msgs: list[Any]) -> None:
+    for sub in subs:
+        for msg in msgs:
+            sub._enqueue(msg)
 
 
 # ===================================================================== graph queries
