@@ -2,7 +2,7 @@
 # Debian packages roverlab's runs and tests need. Idempotent; needs root (or sudo) only
 # when something is missing.
 set -euo pipefail
-packages=()
+packages=(chromium)
 [ ${#packages[@]} -eq 0 ] && exit 0
 missing=()
 for p in "${packages[@]}"; do

@@ -13,6 +13,7 @@ from roverlab.description import cli as urdf_cli
 from roverlab.errors import RoverlabError
 from roverlab.maps import cli as map_cli
 from roverlab.teleop import cli as teleop_cli
+from roverlab.viz import cli as viz_cli
 
 app = typer.Typer(
     name="roverlab",
@@ -29,6 +30,7 @@ app.add_typer(daemon.app, name="daemon")
 app.command("demo")(demo.demo)
 app.command("sim")(sim.sim)
 app.command("launch")(launch.launch)
+app.command("dashboard")(viz_cli.dashboard)
 app.add_typer(urdf_cli.app, name="urdf")
 app.add_typer(map_cli.app, name="map")
 app.command("teleop")(teleop_cli.teleop)

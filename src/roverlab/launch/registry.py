@@ -270,9 +270,11 @@ def _unavailable(reason: str) -> NodeFactory:
     return factory
 
 
-REGISTRY[("rviz", "rviz")] = _unavailable("the web dashboard is not part of roverlab yet")
+REGISTRY[("rviz", "rviz")] = _unavailable(
+    "open the web rviz with `roverlab dashboard` in another terminal"
+)
 REGISTRY[("rqt_image_view", "rqt_image_view")] = _unavailable(
-    "the web dashboard is not part of roverlab yet"
+    "open `roverlab dashboard` in another terminal: it has the image panel"
 )
 for _t in ("teleop_twist_keyboard.py", "teleop_twist_keyboard"):
     REGISTRY[("teleop_twist_keyboard", _t)] = _unavailable(
