@@ -12,6 +12,7 @@ from roverlab.cli.common import NetworkOptions
 from roverlab.description import cli as urdf_cli
 from roverlab.errors import RoverlabError
 from roverlab.maps import cli as map_cli
+from roverlab.slam import cli as slam_cli
 from roverlab.teleop import cli as teleop_cli
 from roverlab.viz import cli as viz_cli
 
@@ -33,6 +34,7 @@ app.command("launch")(launch.launch)
 app.command("dashboard")(viz_cli.dashboard)
 app.add_typer(urdf_cli.app, name="urdf")
 app.add_typer(map_cli.app, name="map")
+app.add_typer(slam_cli.app, name="slam")
 app.command("teleop")(teleop_cli.teleop)
 
 
