@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from roverlab.cli import daemon, demo, graph, launch, sim, tf, topic
+from roverlab.cli import daemon, demo, graph, launch, sim, slam_run, tf, topic
 from roverlab.cli.common import NetworkOptions
 from roverlab.description import cli as urdf_cli
 from roverlab.errors import RoverlabError
@@ -34,6 +34,7 @@ app.command("launch")(launch.launch)
 app.command("dashboard")(viz_cli.dashboard)
 app.add_typer(urdf_cli.app, name="urdf")
 app.add_typer(map_cli.app, name="map")
+slam_cli.app.command("run")(slam_run.run)
 app.add_typer(slam_cli.app, name="slam")
 app.command("teleop")(teleop_cli.teleop)
 
