@@ -21,23 +21,23 @@ from pathlib import Path
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "radish"
 TARGETS = {"hector": 20.0, "gmapping": 10.0, "graph": 15.0}
-# hector's default 25.6 m map is smaller than these buildings
-PARAMS = {"hector": {"map_size": 2048}}
 
 
 def child(method: str, log: str) -> None:
-    from roverlab.mapping.hector import HectorParams, HectorSLAM
+    """One method on one log with default parameters, exactly as ``roverlab slam run``."""
+    from roverlab.cli import slam_run
     from roverlab.slam.logs import load_log
 
     t0 = time.perf_counter()
     records = load_log(log)
     t_load = time.perf_counter() - t0
-    if method != "hector":
+    runner = getattr(slam_run, f"run_{method}", None)
+    if runner is None:
         print(json.dumps({"error": "not available yet"}))
         return
-    slam = HectorSLAM(HectorParams.from_ros(PARAMS["hector"]))
+    kwargs = {"seed": 0, "smooth": True} if method == "gmapping" else {}
     t1 = time.perf_counter()
-    slam.run_log(records)
+    runner(records, {}, **kwargs)
     t_run = time.perf_counter() - t1
     peak_kb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
     print(json.dumps({

@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import math
 import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 DATA = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "radish"
@@ -42,3 +44,52 @@ def test_unknown_method_is_one_line_exit_2(tmp_path: Path) -> None:
     )  # fmt: skip
     assert r.returncode == 2
     assert r.stderr.strip() == "error: unknown method 'karto' (hector, gmapping or graph)"
+
+
+@pytest.mark.skipif(not (DATA / "intel.clf.bz2").is_file(), reason="shared/data/radish is absent")
+def test_gmapping_on_an_intel_slice_is_seeded_and_scores(tmp_path: Path) -> None:
+    def run(out: Path, seed: int) -> str:
+        r = subprocess.run(
+            [sys.executable, "-m", "roverlab.cli", "slam", "run", str(DATA / "intel.clf.bz2"),
+             "--method", "gmapping", "--first", "700", "--seed", str(seed), "--out", str(out)],
+            capture_output=True, text=True, timeout=300,
+        )  # fmt: skip
+        assert r.returncode == 0, r.stderr
+        assert "gmapping: " in r.stderr and "filter updates" in r.stderr
+        return (out / "trajectory.tum").read_text()
+
+    a = run(tmp_path / "a", 3)
+    assert a == run(tmp_path / "b", 3)  # same seed, same trajectory
+    lines = a.splitlines()
+    assert len(lines) == 700 and lines[0].split()[0] == "976052857.337530"
+    assert (tmp_path / "a" / "map.pgm").is_file() and (tmp_path / "a" / "map.png").is_file()
+    e = subprocess.run(
+        [sys.executable, "-m", "roverlab.cli", "slam", "eval",
+         str(tmp_path / "a" / "trajectory.tum"), str(DATA / "intel.relations")],
+        capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert e.returncode == 0, e.stderr
+    trans = float(e.stdout.split("translational error:")[1].split("+-")[0])
+    assert trans < 0.08
+
+
+def test_hector_map_is_sized_to_the_odometry_unless_set() -> None:
+    from roverlab.cli.slam_run import hector_auto_size
+    from roverlab.geometry import SE2
+    from roverlab.slam.logs import LaserLog, ScanRecord
+
+    recs = [
+        ScanRecord(timestamp=float(i), ranges=np.ones(10, np.float32), angle_min=-1.0,
+                   angle_increment=0.2, range_min=0.0, range_max=30.0,
+                   odom_pose=SE2(10.0 + x, 5.0, math.pi / 2))
+        for i, x in enumerate([0.0, -20.0, -40.0])
+    ]  # fmt: skip
+    log = LaserLog(recs)
+    sized = hector_auto_size(log, {})
+    # in the first pose's frame (facing +y) the robot moves 40 m along +y
+    size_m = float(sized["map_size"]) * 0.025  # type: ignore[arg-type]
+    assert size_m >= 50.0 and int(sized["map_size"]) % 256 == 0  # type: ignore[call-overload]
+    assert float(sized["map_start_y"]) * size_m == pytest.approx(5.0)  # type: ignore[arg-type]
+    assert float(sized["map_start_x"]) * size_m == pytest.approx(5.0)  # type: ignore[arg-type]
+    given = {"map_size": 512}
+    assert hector_auto_size(log, given) is given

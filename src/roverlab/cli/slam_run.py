@@ -4,21 +4,119 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Iterator
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, NamedTuple
 
 import numpy as np
 import typer
 import yaml
 from PIL import Image, ImageDraw
+from rich.console import Console
+from rich.progress import (
+    BarColumn,
+    MofNCompleteColumn,
+    Progress,
+    TextColumn,
+    TimeElapsedColumn,
+    TimeRemainingColumn,
+)
 
+from roverlab.mapping.gmapping import GMapping, GMappingParams
 from roverlab.mapping.hector import HectorParams, HectorSLAM
 from roverlab.maps import save_map
 from roverlab.slam.errors import SlamError
-from roverlab.slam.logs import load_log
-from roverlab.slam.trajectory import write_tum
+from roverlab.slam.logs import LaserLog, ScanRecord, load_log
+from roverlab.slam.trajectory import Trajectory, write_tum
 
 METHODS = ("hector", "gmapping", "graph")
+# map edge beyond the odometry's bounding box when hector's map is sized from the log (m)
+_HECTOR_MARGIN_M = 5.0
+
+
+def _progress(records: LaserLog, label: str) -> Iterator[ScanRecord]:
+    """The records, with a progress bar on stderr (refreshed only on a terminal)."""
+    console = Console(stderr=True)
+    if not console.is_terminal:
+        yield from records
+        return
+    with Progress(
+        TextColumn(label), BarColumn(), MofNCompleteColumn(), TextColumn("scans"),
+        TimeElapsedColumn(), TextColumn("<"), TimeRemainingColumn(), console=console,
+        transient=True,
+    ) as bar:  # fmt: skip
+        task = bar.add_task(label, total=len(records))
+        for i, rec in enumerate(records):
+            yield rec
+            if i % 50 == 49:
+                bar.update(task, completed=i + 1)
+
+
+class MethodResult(NamedTuple):
+    """What every method gives back: the map, one pose per scan, the trajectory."""
+
+    data: np.ndarray  # (H, W) int8 -1/0/100, row 0 at the lowest y
+    resolution: float
+    origin: tuple[float, float]
+    poses: np.ndarray  # (N, 3)
+    trajectory: Trajectory
+    notes: list[str]
+
+
+def hector_auto_size(records: LaserLog, params: dict[str, object]) -> dict[str, object]:
+    """hector's map is fixed in size (ROS default 1024 cells of 2.5 cm = 25.6 m, smaller than
+    most buildings). Offline the whole odometry is known, so unless the user set
+    ``map_size`` / ``map_start_x`` / ``map_start_y``, size the map to the odometry's
+    bounding box (in the frame of the first pose) plus a margin."""
+    if any(k in params for k in ("map_size", "map_start_x", "map_start_y")) or len(records) < 2:
+        return params
+    res = float(params.get("map_resolution", HectorParams().map_resolution))  # type: ignore[arg-type]
+    levels = int(params.get("map_multi_res_levels", HectorParams().map_multi_res_levels))  # type: ignore[call-overload]
+    odo = records.odom_poses
+    c, s = math.cos(odo[0, 2]), math.sin(odo[0, 2])
+    d = odo[:, :2] - odo[0, :2]
+    x = c * d[:, 0] + s * d[:, 1]
+    y = -s * d[:, 0] + c * d[:, 1]
+    lo_x, hi_x = min(float(x.min()), 0.0), max(float(x.max()), 0.0)
+    lo_y, hi_y = min(float(y.min()), 0.0), max(float(y.max()), 0.0)
+    span = max(hi_x - lo_x, hi_y - lo_y) + 2 * _HECTOR_MARGIN_M
+    step = 2 ** max(levels - 1, 0) * 64
+    cells = max(HectorParams().map_size, int(math.ceil(span / res / step)) * step)
+    size_m = cells * res
+    out = dict(params)
+    out["map_size"] = cells
+    out["map_start_x"] = (_HECTOR_MARGIN_M - lo_x) / size_m
+    out["map_start_y"] = (_HECTOR_MARGIN_M - lo_y) / size_m
+    return out
+
+
+def run_hector(records: LaserLog, params: dict[str, object]) -> MethodResult:
+    sized = hector_auto_size(records, params)
+    notes = []
+    if sized is not params:
+        notes.append(
+            f"hector map sized to the log: map_size {sized['map_size']} "
+            f"({float(sized['map_size']) * HectorParams.from_ros(sized).map_resolution:.1f} m), "  # type: ignore[arg-type]
+            f"map_start_x {float(sized['map_start_x']):.3f}, "  # type: ignore[arg-type]
+            f"map_start_y {float(sized['map_start_y']):.3f}"  # type: ignore[arg-type]
+        )
+    result = HectorSLAM(HectorParams.from_ros(sized)).run_log(_progress(records, "hector"))
+    m = result.map
+    return MethodResult(m.data, m.resolution, m.origin, result.poses, result.trajectory, notes)
+
+
+def run_gmapping(
+    records: LaserLog, params: dict[str, object], *, seed: int, smooth: bool
+) -> MethodResult:
+    slam = GMapping(GMappingParams.from_ros(params), rng=np.random.default_rng(seed))
+    result = slam.run_log(_progress(records, "gmapping"), interpolate=smooth)
+    m = result.map
+    traj = Trajectory.from_poses(list(records.timestamp_texts), result.poses)
+    notes = [
+        f"gmapping: {slam.updates} filter updates, {slam.resamples} resamplings, "
+        f"{slam.recoveries} odometry-failure recoveries"
+    ]
+    return MethodResult(m.data, m.resolution, m.origin_xy, result.poses, traj, notes)
 
 
 def _params(items: list[str] | None) -> dict[str, object]:
@@ -33,7 +131,20 @@ def _params(items: list[str] | None) -> dict[str, object]:
 
 def _png(path: Path, data: np.ndarray, resolution: float, origin: tuple[float, float],
          poses: np.ndarray) -> None:  # fmt: skip
-    """The map (map_saver's grey levels, top row = max y) with the trajectory in red."""
+    """The map (map_saver's grey levels, top row = max y) with the trajectory in red,
+    cropped to the known cells and the trajectory plus a margin (the .pgm keeps it all)."""
+    rows_k, cols_k = np.nonzero(data >= 0)
+    pc = (poses[:, 0] - origin[0]) / resolution
+    pr = (poses[:, 1] - origin[1]) / resolution
+    pad = 20
+    c0 = int(max(0, min(cols_k.min(initial=data.shape[1]), pc.min(initial=data.shape[1])) - pad))
+    c1 = int(min(data.shape[1], max(cols_k.max(initial=0), pc.max(initial=0)) + pad + 1))
+    r0 = int(max(0, min(rows_k.min(initial=data.shape[0]), pr.min(initial=data.shape[0])) - pad))
+    r1 = int(min(data.shape[0], max(rows_k.max(initial=0), pr.max(initial=0)) + pad + 1))
+    if c1 <= c0 or r1 <= r0:
+        c0, c1, r0, r1 = 0, data.shape[1], 0, data.shape[0]
+    data = data[r0:r1, c0:c1]
+    origin = (origin[0] + c0 * resolution, origin[1] + r0 * resolution)
     img = np.full(data.shape, 205, dtype=np.uint8)
     img[data == 0] = 254
     img[data == 100] = 0
@@ -69,13 +180,30 @@ def run(
     first: Annotated[
         int | None, typer.Option("--first", help="Use only the first N scans of the log.")
     ] = None,
+    seed: Annotated[
+        int, typer.Option("--seed", help="Seed of the random draws (gmapping's particles).")
+    ] = 0,
+    smooth: Annotated[
+        bool,
+        typer.Option(
+            "--smooth/--no-smooth",
+            help="gmapping: scans between two filter updates get a pose blended from both "
+            "updates (offline smoothing), instead of the last update moved by odometry "
+            "(what a live slam_gmapping reports).",
+        ),
+    ] = True,
 ) -> None:
     """Map a recorded log: DIR/map.yaml + map.pgm, DIR/map.png, DIR/trajectory.tum."""
     if method not in METHODS:
         raise SlamError(f"unknown method {method!r} (hector, gmapping or graph)")
-    if method != "hector":
-        raise SlamError(f"method {method!r} is not available yet (hector is)")
-    params = HectorParams.from_ros(_params(param))
+    if method == "graph":
+        raise SlamError("method 'graph' is not available yet (hector and gmapping are)")
+    params = _params(param)
+    # parameter errors before the (long) log reading
+    if method == "hector":
+        HectorParams.from_ros(params)
+    else:
+        GMappingParams.from_ros(params)
     started = time.monotonic()
     if log.suffix in (".clf", ".gz", ".bz2"):
         records = load_log(log)
@@ -86,14 +214,18 @@ def run(
             raise SlamError(f"--first must be at least 2, got {first}")
         records = records[:first]
     typer.echo(f"{len(records)} scans from {log}", err=True)
-    slam = HectorSLAM(params)
-    result = slam.run_log(records)
+    if method == "hector":
+        res = run_hector(records, params)
+    else:
+        res = run_gmapping(records, params, seed=seed, smooth=smooth)
     wall = time.monotonic() - started
+    for note in res.notes:
+        typer.echo(note, err=True)
     out.mkdir(parents=True, exist_ok=True)
-    m = result.map
-    save_map(out / "map", m.data, resolution=m.resolution, origin=(m.origin[0], m.origin[1], 0.0))
-    _png(out / "map.png", m.data, m.resolution, m.origin, np.asarray(result.poses))
-    write_tum(out / "trajectory.tum", result.trajectory)
+    save_map(out / "map", res.data, resolution=res.resolution,
+             origin=(res.origin[0], res.origin[1], 0.0))  # fmt: skip
+    _png(out / "map.png", res.data, res.resolution, res.origin, np.asarray(res.poses))
+    write_tum(out / "trajectory.tum", res.trajectory)
     duration = float(records.timestamps[-1] - records.timestamps[0]) if len(records) > 1 else 0.0
     factor = duration / wall if wall > 0 else math.inf
     typer.echo(
