@@ -88,8 +88,10 @@ def test_hector_map_is_sized_to_the_odometry_unless_set() -> None:
     sized = hector_auto_size(log, {})
     # in the first pose's frame (facing +y) the robot moves 40 m along +y
     size_m = float(sized["map_size"]) * 0.025  # type: ignore[arg-type]
-    assert size_m >= 50.0 and int(sized["map_size"]) % 256 == 0  # type: ignore[call-overload]
-    assert float(sized["map_start_y"]) * size_m == pytest.approx(5.0)  # type: ignore[arg-type]
-    assert float(sized["map_start_x"]) * size_m == pytest.approx(5.0)  # type: ignore[arg-type]
+    assert size_m >= 40.0 + 2 * (5.0 + 0.15 * 40.0)
+    assert int(sized["map_size"]) % 256 == 0  # type: ignore[call-overload]
+    # the box (x 0..0, y 0..40) is centred in the map
+    assert float(sized["map_start_y"]) * size_m == pytest.approx(size_m / 2 - 20.0)  # type: ignore[arg-type]
+    assert float(sized["map_start_x"]) == pytest.approx(0.5)  # type: ignore[arg-type]
     given = {"map_size": 512}
     assert hector_auto_size(log, given) is given

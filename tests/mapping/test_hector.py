@@ -133,7 +133,7 @@ def test_defaults_are_hector_mappings() -> None:
     assert (p.laser_min_dist, p.laser_max_dist) == (0.4, 30.0)
     assert (p.laser_z_min_value, p.laser_z_max_value) == (-1.0, 1.0)
     assert not p.use_odometry and not p.map_with_known_poses
-    assert p.motion_prediction == "constant_pose"
+    assert p.motion_prediction == "constant_velocity"  # roverlab's default (hector: constant_pose)
     assert [p.level_resolution(i) for i in range(3)] == [0.025, 0.05, 0.1]
     assert [p.level_size(i) for i in range(3)] == [1024, 512, 256]
 

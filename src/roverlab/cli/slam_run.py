@@ -30,8 +30,10 @@ from roverlab.slam.logs import LaserLog, ScanRecord, load_log
 from roverlab.slam.trajectory import Trajectory, write_tum
 
 METHODS = ("hector", "gmapping", "graph")
-# map edge beyond the odometry's bounding box when hector's map is sized from the log (m)
+# map edge beyond the odometry's bounding box when hector's map is sized from the log: this
+# much (m) plus a share of the box (odometry drifts, so the true path is not inside it)
 _HECTOR_MARGIN_M = 5.0
+_HECTOR_MARGIN_SHARE = 0.15
 
 
 def _progress(records: LaserLog, label: str) -> Iterator[ScanRecord]:
@@ -79,14 +81,17 @@ def hector_auto_size(records: LaserLog, params: dict[str, object]) -> dict[str, 
     y = -s * d[:, 0] + c * d[:, 1]
     lo_x, hi_x = min(float(x.min()), 0.0), max(float(x.max()), 0.0)
     lo_y, hi_y = min(float(y.min()), 0.0), max(float(y.max()), 0.0)
-    span = max(hi_x - lo_x, hi_y - lo_y) + 2 * _HECTOR_MARGIN_M
+    box = max(hi_x - lo_x, hi_y - lo_y)
+    margin = _HECTOR_MARGIN_M + _HECTOR_MARGIN_SHARE * box
+    span = box + 2 * margin
     step = 2 ** max(levels - 1, 0) * 64
     cells = max(HectorParams().map_size, int(math.ceil(span / res / step)) * step)
     size_m = cells * res
     out = dict(params)
     out["map_size"] = cells
-    out["map_start_x"] = (_HECTOR_MARGIN_M - lo_x) / size_m
-    out["map_start_y"] = (_HECTOR_MARGIN_M - lo_y) / size_m
+    # centre the box in the map
+    out["map_start_x"] = 0.5 - 0.5 * (lo_x + hi_x) / size_m
+    out["map_start_y"] = 0.5 - 0.5 * (lo_y + hi_y) / size_m
     return out
 
 

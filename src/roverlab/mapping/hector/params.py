@@ -74,9 +74,11 @@ class HectorParams:
         use_odometry: (roverlab) start each match at the previous estimate moved by the
             odometry delta since the previous scan (the role of hector's TF start
             estimate); False, hector's default, ignores odometry.
-        motion_prediction: (roverlab) the prediction without odometry: ``"constant_pose"``
-            (hector: the previous estimate) or ``"constant_velocity"`` (the previous
-            estimate moved by the last scan-to-scan motion).
+        motion_prediction: (roverlab) the prediction without odometry:
+            ``"constant_velocity"`` (the default: the previous estimate moved by the last
+            scan-to-scan motion) or ``"constant_pose"`` (hector's: the previous estimate).
+            Constant velocity keeps fast turns of low-rate scanners inside the matcher's
+            basin (fr079: 0.033 m instead of losing track) and costs nothing.
         scan_match_iterations_coarse: (roverlab) at most this many Gauss-Newton steps on
             each coarse level; a level stops early once the steps become tiny (hector
             always makes 4).
@@ -107,7 +109,7 @@ class HectorParams:
     laser_z_max_value: float = 1.0
     map_with_known_poses: bool = False
     use_odometry: bool = False
-    motion_prediction: str = "constant_pose"
+    motion_prediction: str = "constant_velocity"
     scan_match_iterations_coarse: int = 10
     scan_match_iterations_fine: int = 20
     scan_match_angle_search: float = 0.3
