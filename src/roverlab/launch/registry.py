@@ -17,8 +17,11 @@ from typing import Any
 from roverlab.core import Context, Node, QoSProfile
 from roverlab.description import load_robot
 from roverlab.description.node import JointStatePublisher, RobotStatePublisher
+from roverlab.errors import RoverlabError
 from roverlab.geometry import quat_from_rpy
 from roverlab.launch.xml import LaunchError, NodeSpec
+from roverlab.mapping.gmapping.node import SlamGMapping
+from roverlab.mapping.hector.node import HectorMapping
 from roverlab.maps.node import MapSaver, MapServer
 from roverlab.msgs import classes as mc
 from roverlab.world import BUNDLED_WORLDS, load_world
@@ -260,6 +263,23 @@ def _map_saver(state: LaunchState, spec: NodeSpec) -> Node:
             raise LaunchError(f"{spec.source}: map_saver -f needs a file name")
         prefix = argv[i + 1]
     return MapSaver(state.context, path_prefix=prefix, node_name=spec.name, **_kwargs(spec))
+
+
+def _slam_node(make: Callable[..., Node]) -> NodeFactory:
+    """A SLAM node from its ``<node>``: private ``<param>``s/``<rosparam>`` and remaps pass
+    through; a bad value is a LaunchError naming the file (unused ones are warned about)."""
+
+    def factory(state: LaunchState, spec: NodeSpec) -> Node:
+        try:
+            return make(state.context, node_name=spec.name, **_kwargs(spec))
+        except (RoverlabError, ValueError) as err:
+            raise LaunchError(f"{spec.source}: {spec.pkg}/{spec.type}: {err}") from err
+
+    return factory
+
+
+REGISTRY[("gmapping", "slam_gmapping")] = _slam_node(SlamGMapping)
+REGISTRY[("hector_mapping", "hector_mapping")] = _slam_node(HectorMapping)
 
 
 def _unavailable(reason: str) -> NodeFactory:
