@@ -14,7 +14,36 @@ from roverlab.cli.sim import parse_rate
 from roverlab.core import Context, configure_logging
 from roverlab.core.transport.zenoh import ZenohTransport
 from roverlab.description import find_package
-from roverlab.launch import LaunchError, build_launch
+from roverlab.launch import LaunchError, LaunchSpec, build_launch, load_launch
+
+CLOCKS = ("auto", "sim", "external", "wall")
+_SIMULATOR_NODES = {("gazebo_ros", "gzserver"), ("gazebo_ros", "spawn_model")}
+
+
+def choose_clock(spec: LaunchSpec, clock: str, pace: float) -> tuple[str, str]:
+    """The context's clock mode for a launch, and a note saying why.
+
+    ``auto``: a launch with a simulator (gzserver / spawn_model) runs it on its own clock
+    (paced by ``--rate``); one without follows ``/clock`` from another process (a
+    ``roverlab sim`` in another terminal: what ROS does with ``/use_sim_time`` true, which
+    a Gazebo launch sets for everybody), unless the file sets ``/use_sim_time`` false,
+    which means wall time.
+    """
+    if clock not in CLOCKS:
+        raise LaunchError(f"unknown --clock {clock!r} ({', '.join(CLOCKS)})")
+    own = "sim" if math.isinf(pace) else "paced"
+    if clock == "sim":
+        return own, ""
+    if clock != "auto":
+        return clock, ""
+    if any((n.pkg, n.type) in _SIMULATOR_NODES for n in spec.nodes):
+        return own, ""
+    if spec.params.get("/use_sim_time") is False:
+        return "wall", "no simulator in this launch and /use_sim_time is false: wall time"
+    return "external", (
+        "no simulator in this launch: following /clock from another process "
+        "(start `roverlab sim` elsewhere, or pass --clock wall)"
+    )
 
 
 def _resolve(target: list[str]) -> tuple[Path, dict[str, str]]:
@@ -56,14 +85,24 @@ def launch(
         bool,
         typer.Option("--expose/--no-expose", help="Make the topics visible to other processes."),
     ] = True,
+    clock: Annotated[
+        str,
+        typer.Option(
+            "--clock",
+            help="auto: the launch's own clock when it starts a simulator, else follow /clock "
+            "from another process (wall time if the file sets /use_sim_time false); sim: "
+            "always its own clock (paced by --rate); external; wall.",
+        ),
+    ] = "auto",
 ) -> None:
     """Run a .launch file (roslaunch): its nodes, its Gazebo world and spawned robot."""
     path, args = _resolve(target)
     pace = parse_rate(rate)
     configure_logging()
-    context = Context(
-        clock="sim" if math.isinf(pace) else "paced", rate=1.0 if math.isinf(pace) else pace
-    )
+    mode, note = choose_clock(load_launch(path, args), clock, pace)
+    if note:
+        typer.echo(f"note: {note}", err=True)
+    context = Context(clock=mode, rate=1.0 if math.isinf(pace) else pace)
     recorder = None
     try:
         if record is not None:

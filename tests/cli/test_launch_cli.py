@@ -1,0 +1,69 @@
+"""``roverlab launch``: the clock a launch runs on, and a SLAM launch beside a simulator."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from roverlab.cli.launch import choose_clock
+from roverlab.launch import LaunchError, load_launch
+from tests.helpers.procs import Proc
+
+FIXTURES = Path(__file__).resolve().parents[1] / "mapping" / "fixtures"
+
+
+def _launch(tmp_path: Path, body: str) -> Path:
+    path = tmp_path / "x.launch"
+    path.write_text(f"<launch>{body}</launch>")
+    return path
+
+
+def test_a_launch_with_a_simulator_runs_its_own_clock(tmp_path: Path) -> None:
+    path = _launch(
+        tmp_path,
+        '<node pkg="gazebo_ros" type="gzserver" name="gazebo" args="worlds/empty.world"/>',
+    )
+    assert choose_clock(load_launch(path), "auto", 1.0) == ("paced", "")
+    assert choose_clock(load_launch(path), "auto", float("inf")) == ("sim", "")
+
+
+def test_a_launch_without_a_simulator_follows_clock_or_wall_time(tmp_path: Path) -> None:
+    mode, note = choose_clock(load_launch(FIXTURES / "gmapping.launch"), "auto", 1.0)
+    assert mode == "external" and "/clock" in note
+    off = _launch(tmp_path, '<param name="/use_sim_time" value="false"/>')
+    assert choose_clock(load_launch(off), "auto", 1.0)[0] == "wall"
+    assert choose_clock(load_launch(off), "sim", 1.0) == ("paced", "")
+    assert choose_clock(load_launch(off), "external", 1.0) == ("external", "")
+    with pytest.raises(LaunchError, match="unknown --clock 'gps'"):
+        choose_clock(load_launch(off), "gps", 1.0)
+
+
+@pytest.mark.zenoh
+def test_seed_gmapping_launch_maps_a_simulator_in_another_process(
+    daemon: str, tmp_path: Path
+) -> None:
+    """Seed 000's workflow on three terminals: the simulator, the gmapping launch file,
+    a turning command; then map_saver writes the map the launch's node built."""
+    cli = [sys.executable, "-m", "roverlab.cli"]
+    sim = Proc([*cli, "sim", "--world", "maze", "--robot", "mybot", "--rate", "2",
+                "--duration", "60"])  # fmt: skip
+    slam = Proc([*cli, "launch", str(FIXTURES / "gmapping.launch"), "--duration", "50"])
+    pub = Proc([*cli, "topic", "pub", "-r", "10", "/cmd_vel", "geometry_msgs/Twist",
+                "{angular: {z: 0.6}}"])  # fmt: skip
+    try:
+        saver = Proc([*cli, "map", "save", "-f", str(tmp_path / "maze"), "--timeout", "90"])
+        assert saver.popen.wait(timeout=120) == 0, saver.stop()
+    finally:
+        pub.stop()
+        slam_err = slam.stop()
+        sim.stop()
+    assert "following /clock from another process" in slam_err
+    pgm = Image.open(tmp_path / "maze.pgm")
+    img = np.asarray(pgm)
+    # map_saver's values: free 254, occupied 0, unknown 205; the robot saw walls around it
+    assert (img == 254).sum() > 500 and (img == 0).sum() > 50
+    assert (tmp_path / "maze.yaml").read_text().startswith("image: ")
