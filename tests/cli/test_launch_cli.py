@@ -67,3 +67,25 @@ def test_seed_gmapping_launch_maps_a_simulator_in_another_process(
     # map_saver's values: free 254, occupied 0, unknown 205; the robot saw walls around it
     assert (img == 254).sum() > 500 and (img == 0).sum() > 50
     assert (tmp_path / "maze.yaml").read_text().startswith("image: ")
+
+
+def test_bundled_mbot_navigation_has_the_seed_launch_files() -> None:
+    from roverlab.core import Context
+    from roverlab.description import find_package
+    from roverlab.launch import build_launch
+
+    pkg = find_package("mbot_navigation")
+    demo = load_launch(pkg / "launch" / "gmapping_demo.launch")
+    assert [(n.pkg, n.type) for n in demo.nodes] == [
+        ("gmapping", "slam_gmapping"),
+        ("rviz", "rviz"),
+    ]
+    assert demo.nodes[1].args.endswith("mbot_navigation/rviz/gmapping.rviz")
+    assert (pkg / "rviz" / "gmapping.rviz").is_file()
+    for name, node in (("gmapping.launch", "slam_gmapping"), ("hector.launch", "hector_mapping")):
+        ctx = Context()
+        try:
+            started = build_launch(pkg / "launch" / name, context=ctx)
+            assert [n.get_name() for n in started.nodes] == [node]
+        finally:
+            ctx.shutdown()
