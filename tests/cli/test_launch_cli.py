@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import subprocess
 import sys
 from pathlib import Path
 
@@ -67,6 +68,14 @@ def test_seed_gmapping_launch_maps_a_simulator_in_another_process(
     # map_saver's values: free 254, occupied 0, unknown 205; the robot saw walls around it
     assert (img == 254).sum() > 500 and (img == 0).sum() > 50
     assert (tmp_path / "maze.yaml").read_text().startswith("image: ")
+    # and the saved map matches the world (roverlab slam mapeval)
+    r = subprocess.run(
+        [*cli, "slam", "mapeval", str(tmp_path / "maze.yaml"), "--world", "maze",
+         "--min-accuracy", "0.95", "--png", str(tmp_path / "overlay.png")],
+        capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert "known cells correct" in r.stdout and (tmp_path / "overlay.png").is_file()
 
 
 def test_bundled_mbot_navigation_has_the_seed_launch_files() -> None:

@@ -95,3 +95,33 @@ def test_hector_map_is_sized_to_the_odometry_unless_set() -> None:
     assert float(sized["map_start_x"]) == pytest.approx(0.5)  # type: ignore[arg-type]
     given = {"map_size": 512}
     assert hector_auto_size(log, given) is given
+
+
+@pytest.mark.skipif(not (DATA / "intel.clf.bz2").is_file(), reason="shared/data/radish is absent")
+def test_graph_on_an_intel_slice_scores(tmp_path: Path) -> None:
+    out = tmp_path / "g"
+    r = subprocess.run(
+        [sys.executable, "-m", "roverlab.cli", "slam", "run", str(DATA / "intel.clf.bz2"),
+         "--method", "graph", "--first", "1000", "--out", str(out)],
+        capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert r.returncode == 0, r.stderr
+    assert "graph: " in r.stderr and "keyframes" in r.stderr
+    assert len((out / "trajectory.tum").read_text().splitlines()) == 1000
+    e = subprocess.run(
+        [sys.executable, "-m", "roverlab.cli", "slam", "eval", str(out / "trajectory.tum"),
+         str(DATA / "intel.relations")],
+        capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert e.returncode == 0, e.stderr
+    assert float(e.stdout.split("translational error:")[1].split("+-")[0]) < 0.05
+
+
+def test_graph_parameter_errors_come_before_reading_the_log(tmp_path: Path) -> None:
+    r = subprocess.run(
+        [sys.executable, "-m", "roverlab.cli", "slam", "run", str(tmp_path / "absent.clf"),
+         "--method", "graph", "--param", "no_such_thing:=1"],
+        capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert r.returncode == 2
+    assert "no_such_thing" in r.stderr and len(r.stderr.strip().splitlines()) == 1

@@ -27,6 +27,7 @@ import pytest
 from roverlab.core import Context, Node
 from roverlab.geometry import SE2, wrap_angle
 from roverlab.launch import build_launch
+from roverlab.mapping.graph.node import SlamToolbox
 from roverlab.msgs import Twist, xytheta_from_pose
 from roverlab.msgs import classes as mc
 from roverlab.sim.app import Simulation
@@ -63,6 +64,7 @@ METHODS: dict[str, Method] = {
     for m in (
         Method("gmapping", _seed_launch("gmapping.launch")),
         Method("hector", _seed_launch("hector.launch")),
+        Method("graph", lambda ctx: SlamToolbox(ctx)),  # slam_toolbox's defaults
     )
 }
 

@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from roverlab.cli import daemon, demo, graph, launch, sim, slam_run, tf, topic
+from roverlab.cli import daemon, demo, graph, launch, sim, slam_mapeval, slam_run, tf, topic
 from roverlab.cli.common import NetworkOptions
 from roverlab.description import cli as urdf_cli
 from roverlab.errors import RoverlabError
@@ -35,6 +35,7 @@ app.command("dashboard")(viz_cli.dashboard)
 app.add_typer(urdf_cli.app, name="urdf")
 app.add_typer(map_cli.app, name="map")
 slam_cli.app.command("run")(slam_run.run)
+slam_cli.app.command("mapeval")(slam_mapeval.mapeval)
 app.add_typer(slam_cli.app, name="slam")
 app.command("teleop")(teleop_cli.teleop)
 

@@ -23,6 +23,7 @@ from rich.progress import (
 )
 
 from roverlab.mapping.gmapping import GMapping, GMappingParams
+from roverlab.mapping.graph import GraphParams, GraphSLAM
 from roverlab.mapping.hector import HectorParams, HectorSLAM
 from roverlab.maps import save_map
 from roverlab.slam.errors import SlamError
@@ -52,6 +53,15 @@ def _progress(records: LaserLog, label: str) -> Iterator[ScanRecord]:
             yield rec
             if i % 50 == 49:
                 bar.update(task, completed=i + 1)
+
+
+def run_graph(records: LaserLog, params: dict[str, object]) -> MethodResult:
+    slam = GraphSLAM(GraphParams.from_ros(params))
+    result = slam.run_log(_progress(records, "graph"))
+    m = result.map
+    g = slam.graph()
+    notes = [f"graph: {g.num_vertices} keyframes, {g.num_edges} constraints"]
+    return MethodResult(m.data, m.resolution, m.origin, result.poses, result.trajectory, notes)
 
 
 class MethodResult(NamedTuple):
@@ -201,14 +211,14 @@ def run(
     """Map a recorded log: DIR/map.yaml + map.pgm, DIR/map.png, DIR/trajectory.tum."""
     if method not in METHODS:
         raise SlamError(f"unknown method {method!r} (hector, gmapping or graph)")
-    if method == "graph":
-        raise SlamError("method 'graph' is not available yet (hector and gmapping are)")
     params = _params(param)
     # parameter errors before the (long) log reading
     if method == "hector":
         HectorParams.from_ros(params)
-    else:
+    elif method == "gmapping":
         GMappingParams.from_ros(params)
+    else:
+        GraphParams.from_ros(params)
     started = time.monotonic()
     if log.suffix in (".clf", ".gz", ".bz2"):
         records = load_log(log)
@@ -221,8 +231,10 @@ def run(
     typer.echo(f"{len(records)} scans from {log}", err=True)
     if method == "hector":
         res = run_hector(records, params)
-    else:
+    elif method == "gmapping":
         res = run_gmapping(records, params, seed=seed, smooth=smooth)
+    else:
+        res = run_graph(records, params)
     wall = time.monotonic() - started
     for note in res.notes:
         typer.echo(note, err=True)

@@ -21,6 +21,7 @@ from roverlab.errors import RoverlabError
 from roverlab.geometry import quat_from_rpy
 from roverlab.launch.xml import LaunchError, NodeSpec
 from roverlab.mapping.gmapping.node import SlamGMapping
+from roverlab.mapping.graph.node import SlamKarto, SlamToolbox
 from roverlab.mapping.hector.node import HectorMapping
 from roverlab.maps.node import MapSaver, MapServer
 from roverlab.msgs import classes as mc
@@ -280,6 +281,9 @@ def _slam_node(make: Callable[..., Node]) -> NodeFactory:
 
 REGISTRY[("gmapping", "slam_gmapping")] = _slam_node(SlamGMapping)
 REGISTRY[("hector_mapping", "hector_mapping")] = _slam_node(HectorMapping)
+REGISTRY[("slam_toolbox", "async_slam_toolbox_node")] = _slam_node(SlamToolbox)
+REGISTRY[("slam_toolbox", "sync_slam_toolbox_node")] = _slam_node(SlamToolbox)
+REGISTRY[("slam_karto", "slam_karto")] = _slam_node(SlamKarto)
 
 
 def _unavailable(reason: str) -> NodeFactory:
