@@ -7,20 +7,34 @@ import math
 import struct
 
 import numpy as np
+import pytest
 from PIL import Image
 
 from roverlab.description.urdf import parse_urdf
 from roverlab.geometry import Transform3, quat_from_yaw
 from roverlab.viz.protocol import (
+    IMAGE_JPEG,
+    IMAGE_PNG,
     INITIALPOSE_COVARIANCE,
     KIND_IMAGE,
     KIND_MAP,
+    KIND_MAP_PATCH,
+    KIND_PATH,
+    KIND_POINTS,
+    KIND_POSES,
     KIND_SCAN,
+    colorize,
     convex_hull,
     encode_image,
+    encode_image_file,
     encode_map,
+    encode_map_patch,
+    encode_path,
+    encode_points,
+    encode_poses,
     encode_scan,
     image_to_rgb8,
+    rainbow,
     robot_outlines,
 )
 from roverlab.viz.server import is_loopback
@@ -39,7 +53,7 @@ URDF = """<robot name="r">
 def test_map_frame_round_trips() -> None:
     cells = np.array([[0, 100, -1], [50, 0, 0]], dtype=np.int8)
     frame = encode_map(cells, resolution_m=0.05, origin=(-1.0, 2.0, 0.5))
-    kind, w, h, res, ox, oy, oyaw = struct.unpack_from("<B3xIIffff", frame)
+    kind, w, h, res, ox, oy, oyaw = struct.unpack_from("<B3xIIffff", frame)  # slot 0
     assert (kind, w, h) == (KIND_MAP, 3, 2)
     assert math.isclose(res, 0.05, rel_tol=1e-6) and (ox, oy) == (-1.0, 2.0)
     assert math.isclose(oyaw, 0.5, rel_tol=1e-6)
@@ -49,8 +63,48 @@ def test_map_frame_round_trips() -> None:
 def test_scan_frame_round_trips() -> None:
     pts = np.array([[1.0, 2.0], [-3.5, 0.25]])
     frame = encode_scan(pts)
-    assert frame[0] == KIND_SCAN and struct.unpack_from("<I", frame, 4)[0] == 2
-    assert np.array_equal(np.frombuffer(frame[8:], dtype="<f4").reshape(-1, 2), pts)
+    assert frame[0] == KIND_SCAN and struct.unpack_from("<II", frame, 4) == (2, 1)
+    assert struct.unpack_from("<I", frame, 12)[0] == 2  # one bucket of both points
+    assert frame[16:20] == bytes([255, 0, 0, 255])
+    assert np.array_equal(np.frombuffer(frame[20:], dtype="<f4").reshape(-1, 2), pts)
+
+
+def test_points_are_sorted_into_colour_buckets() -> None:
+    pts = np.array([[0.0, 0.0], [1.0, 1.0], [2.0, 2.0], [3.0, 3.0]])
+    palette = [(255, 0, 0, 255), (0, 255, 0, 255), (0, 0, 255, 128)]
+    frame = encode_points(pts, np.array([2, 0, 2, 0]), palette, slot=7)
+    kind, _, slot, n, nb = struct.unpack_from("<BBHII", frame)
+    assert (kind, slot, n, nb) == (KIND_POINTS, 7, 4, 3)
+    counts = np.frombuffer(frame[12:24], dtype="<u4")
+    assert counts.tolist() == [2, 0, 2]
+    assert frame[24:36] == bytes([255, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 128])
+    out = np.frombuffer(frame[36:], dtype="<f4").reshape(-1, 2)
+    assert out.tolist() == [[1, 1], [3, 3], [0, 0], [2, 2]]
+
+
+def test_pose_path_and_patch_frames() -> None:
+    poses = np.array([[1.0, 2.0, 0.5]])
+    f = encode_poses(poses, slot=3)
+    assert struct.unpack_from("<BBHI", f) == (KIND_POSES, 0, 3, 1)
+    assert np.allclose(np.frombuffer(f[8:], dtype="<f4"), [1.0, 2.0, 0.5])
+    p = encode_path(np.array([[0.0, 0.0], [1.0, 0.5]]))
+    assert struct.unpack_from("<BBHI", p) == (KIND_PATH, 0, 0, 2)
+    cells = np.array([[1, 2, 3]], dtype=np.int8)
+    m = encode_map_patch(cells, 4, 5)
+    assert struct.unpack_from("<BBHIIII", m) == (KIND_MAP_PATCH, 0, 0, 4, 5, 3, 1)
+    assert m[20:] == cells.tobytes()
+
+
+def test_compressed_images_pass_through() -> None:
+    buf = io.BytesIO()
+    Image.fromarray(np.zeros((4, 4, 3), dtype=np.uint8)).save(buf, format="PNG")
+    png = buf.getvalue()
+    frame = encode_image_file(png)
+    assert frame[0] == KIND_IMAGE and frame[1] == IMAGE_PNG and frame[4:] == png
+    jpeg = encode_image(np.zeros((4, 4, 3), dtype=np.uint8))[4:]
+    assert encode_image_file(jpeg)[1] == IMAGE_JPEG
+    with pytest.raises(ValueError, match="neither JPEG nor PNG"):
+        encode_image_file(b"GIF89a....")
 
 
 def test_image_frame_is_a_jpeg_of_rgb_pixels() -> None:
@@ -68,6 +122,27 @@ def test_depth_image_is_scaled_to_eight_bits() -> None:
     depth = np.array([[1.0, 2.0], [3.0, np.nan]], dtype=np.float32)
     out = image_to_rgb8(depth, "32FC1")
     assert out.dtype == np.uint8 and out.tolist() == [[0, 127], [255, 0]]
+
+
+def test_depth_colour_maps() -> None:
+    depth = np.array([[0, 1000, 2000, 3000]], dtype=np.uint16)  # 16UC1 mm; 0 = no data
+    jet = image_to_rgb8(depth, "16UC1", color_map="jet")
+    assert jet.shape == (1, 4, 3)
+    assert jet[0, 0].tolist() == [0, 0, 0]  # no data: black
+    assert jet[0, 1, 2] > 100 and jet[0, 1, 0] == 0  # near: blue
+    assert jet[0, 3, 0] > 100 and jet[0, 3, 2] == 0  # far: red
+    fixed = colorize(np.array([[1.0, 5.0, 9.0]]), "gray", min_value=1.0, max_value=5.0)
+    assert fixed[0, :, 0].tolist() == [0, 255, 255]  # clipped at max_value
+    hot = colorize(np.array([[0.0, 1.0]]), "hot")
+    assert hot[0, 0].tolist() == [0, 0, 0] and hot[0, 1].tolist() == [255, 255, 255]
+    with pytest.raises(ValueError, match="unknown colour map"):
+        colorize(depth, "viridis")
+
+
+def test_rainbow_runs_from_magenta_to_red() -> None:
+    ends = (rainbow(np.array([0.0, 0.5, 1.0])) * 255).round().astype(int).tolist()
+    assert ends[0] == [255, 0, 255] and ends[2] == [255, 0, 0]
+    assert ends[1][1] == 255  # the middle is green-ish
 
 
 def test_convex_hull_drops_inner_points() -> None:

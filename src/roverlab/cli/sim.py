@@ -14,6 +14,7 @@ from roverlab.core import Context, configure_logging
 from roverlab.core.transport.zenoh import ZenohTransport
 from roverlab.sim.app import Simulation, SimulationError
 from roverlab.sim.node import SpawnPose
+from roverlab.viz.server import DashboardServer
 
 
 def parse_rate(text: str) -> float:
@@ -87,6 +88,13 @@ def sim(
             help="Make the topics visible to other processes (roverlab topic echo, teleop).",
         ),
     ] = True,
+    dashboard: Annotated[
+        bool,
+        typer.Option("--dashboard", help="Serve the web dashboard (rviz) from this process."),
+    ] = False,
+    dashboard_port: Annotated[
+        int, typer.Option("--dashboard-port", help="Port of the --dashboard (127.0.0.1).")
+    ] = 8080,
 ) -> None:
     """Simulate a robot in a world: /cmd_vel in; /odom, /tf, /scan, /imu, cameras, /clock out."""
     pace = parse_rate(rate)
@@ -124,6 +132,14 @@ def sim(
         f"(rate {rate}, seed {seed}); sensors: {', '.join(sensors) or 'none'}",
         err=True,
     )
+    if dashboard:  # the context's shutdown (end of run_context) stops it
+        try:
+            server = DashboardServer(context, "127.0.0.1", dashboard_port)
+            server.start()
+        except BaseException:
+            context.shutdown()
+            raise
+        typer.echo(f"dashboard: {server.url}", err=True)
     wall = run_context(context, duration)
     sim_s = context.now().seconds
     typer.echo(

@@ -25,6 +25,8 @@ from roverlab.mapping.graph.node import SlamKarto, SlamToolbox
 from roverlab.mapping.hector.node import HectorMapping
 from roverlab.maps.node import MapSaver, MapServer
 from roverlab.msgs import classes as mc
+from roverlab.viz.errors import DashboardError
+from roverlab.viz.launcher import start_rviz
 from roverlab.world import BUNDLED_WORLDS, load_world
 
 __all__ = ["REGISTRY", "LaunchState", "NodeFactory", "register"]
@@ -294,9 +296,21 @@ def _unavailable(reason: str) -> NodeFactory:
     return factory
 
 
-REGISTRY[("rviz", "rviz")] = _unavailable(
-    "open the web rviz with `roverlab dashboard` in another terminal"
-)
+@register("rviz", "rviz")
+def _rviz(state: LaunchState, spec: NodeSpec) -> Node | None:
+    """The web dashboard on the launch's context (``-d FILE.rviz``, ``-f FRAME``)."""
+    try:
+        return start_rviz(
+            state.context,
+            spec.args,
+            node_name=spec.name,
+            source=spec.source,
+            warn=state.warnings.append,
+        )
+    except DashboardError as err:
+        raise LaunchError(f"{spec.source}: rviz: {err}") from err
+
+
 REGISTRY[("rqt_image_view", "rqt_image_view")] = _unavailable(
     "open `roverlab dashboard` in another terminal: it has the image panel"
 )

@@ -1,50 +1,114 @@
 """The dashboard's node: subscribes to what the displays draw, publishes what the tools make.
 
-:class:`VizBridge` is the only part of :mod:`roverlab.viz` that touches the bus. Its
-subscription callbacks run on the executor thread and only store the newest data with a
-version number; the web server's threads read snapshots (``*_frame`` / :meth:`state`)
-and compare versions, so each client gets only what changed.
+:class:`VizBridge` is the only part of :mod:`roverlab.viz` that touches the bus. It holds
+the :class:`~roverlab.viz.config.DashboardConfig` and one :class:`DisplayState` per display
+(its subscription, its newest frame, its status). Subscription callbacks run on the
+executor thread and only store the newest data with a version number; the web server's
+threads read snapshots and compare versions, so each client gets only what changed.
+Configuration changes from the page are applied on the executor thread
+(:meth:`VizBridge.set_config`).
 """
 
 from __future__ import annotations
 
+import io
+import json
+import math
+import re
 import threading
-from dataclasses import dataclass
+import time
+from collections import deque
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any, Final
 
 import numpy as np
+from PIL import Image
 
-from roverlab.core import Context, QoSProfile, Time
+from roverlab.core import Context, Node, QoSProfile, Time
 from roverlab.description.urdf import parse_urdf
+from roverlab.errors import RoverlabError
 from roverlab.geometry import Transform3, yaw_from_quat
+from roverlab.maps import save_map
 from roverlab.msgs import (
     PointStamped,
     PoseStamped,
     PoseWithCovarianceStamped,
     image_to_array,
     occupancy_grid_to_array,
+    pointcloud2_to_xyz,
     pose_from_xytheta,
     scan_to_points,
     stamp_to_msg,
     yaw_from_quaternion,
 )
-from roverlab.teleop import twist_for_key
+from roverlab.teleop import SPEED_BINDINGS, twist_for_key
 from roverlab.teleop.node import command_to_twist
 from roverlab.tf import Buffer, TransformException, TransformListener
+from roverlab.viz.config import (
+    DISPLAY_KINDS,
+    DashboardConfig,
+    DisplayConfig,
+    default_config,
+)
+from roverlab.viz.displays import (
+    MarkerStore,
+    PoseTrail,
+    color_buckets,
+    decimate,
+    map_change,
+    poses_in_fixed,
+)
+from roverlab.viz.errors import DashboardError
 from roverlab.viz.protocol import (
     INITIALPOSE_COVARIANCE,
     VisualOutline,
+    colorize,
     encode_image,
+    encode_image_file,
     encode_map,
-    encode_scan,
+    encode_map_patch,
+    encode_path,
+    encode_points,
+    encode_poses,
     image_to_rgb8,
     robot_outlines,
 )
 
-__all__ = ["IMAGE_TYPE", "Versioned", "VizBridge"]
+__all__ = [
+    "COMPRESSED_TYPE",
+    "IMAGE_TYPE",
+    "DisplayState",
+    "RvizNode",
+    "TopicInfo",
+    "Versioned",
+    "VizBridge",
+]
 
 IMAGE_TYPE: Final = "sensor_msgs/msg/Image"
+COMPRESSED_TYPE: Final = "sensor_msgs/msg/CompressedImage"
 _LATCHED: Final = QoSProfile(depth=1, durability="transient_local")
+_MAX_PATCHES: Final = 16
+_RATE_WINDOW_S: Final = 3.0
+_MAP_NAME: Final = re.compile(r"^[A-Za-z0-9_.-]{1,100}$")
+
+
+class RvizNode(Node):
+    """The dashboard's node; :attr:`on_destroy` callbacks run when it is destroyed (the
+    context shutting down stops the web server with it). :attr:`server` is the
+    :class:`~roverlab.viz.server.DashboardServer` serving it, if any."""
+
+    def __init__(self, node_name: str, *, context: Context) -> None:
+        super().__init__(node_name, context=context)
+        self.on_destroy: list[Callable[[], None]] = []
+        self.server: Any = None
+
+    def destroy_node(self) -> None:
+        callbacks, self.on_destroy = self.on_destroy, []
+        for callback in callbacks:
+            callback()
+        super().destroy_node()
 
 
 @dataclass(frozen=True)
@@ -55,6 +119,55 @@ class Versioned:
     payload: Any
 
 
+@dataclass(frozen=True)
+class TopicInfo:
+    """One topic of the running system, as the topic list shows it."""
+
+    name: str
+    typename: str
+    publishers: int
+    subscribers: int
+
+
+@dataclass
+class DisplayState:
+    """What one display has: its config, subscription, newest frame and status.
+
+    Attributes:
+        slot: index in the configuration (the server writes it into the frames' header,
+            which are stored with slot 0, so a reordered configuration re-uses them).
+        config: the display's configuration.
+        frame: newest binary frame (for markers: the JSON text of the primitive list).
+        map_base: a map display's last full frame; ``map_patches`` follow it.
+        status: status-tree rows ``name -> (level, text)``, level ``ok|warn|error``.
+        received: messages received since subscribing.
+        info: small per-display data for the JSON state (e.g. a map's frame).
+    """
+
+    slot: int
+    config: DisplayConfig
+    frame: Versioned | None = None
+    map_base: Versioned | None = None
+    map_patches: list[Versioned] = field(default_factory=list)
+    map_cells: Any = None
+    map_key: tuple[Any, ...] = ()
+    map_msg: Any = None
+    status: dict[str, tuple[str, str]] = field(default_factory=dict)
+    received: int = 0
+    info: dict[str, Any] = field(default_factory=dict)
+    sub: Any = None
+    sub_key: tuple[str, str] = ("", "")
+    trail: PoseTrail | None = None
+    markers: MarkerStore | None = None
+    image_msg: Versioned | None = None
+    image_jpeg: Versioned | None = None
+    error: str | None = None
+
+    @property
+    def kind(self) -> str:
+        return self.config.kind
+
+
 def _xyyaw(t: Transform3) -> list[float]:
     return [
         round(t.translation[0], 4),
@@ -63,14 +176,27 @@ def _xyyaw(t: Transform3) -> list[float]:
     ]
 
 
+def _stamp_time(header: Any) -> Time:
+    return Time(int(header.stamp.sec) * 1_000_000_000 + int(header.stamp.nanosec))
+
+
+def _rgb(config: DisplayConfig) -> tuple[int, int, int]:
+    c = config.option("color")
+    return int(c[0]), int(c[1]), int(c[2])
+
+
 class VizBridge:
     """Subscriptions and publishers of the dashboard in ``context``.
 
     Args:
         context: the context to attach to (in-process, or a :class:`Connection`'s).
-        fixed_frame: frame the displays are drawn in; ``odom`` is used while it is unknown.
+        fixed_frame: frame the displays are drawn in when ``config`` is not given.
+        config: the displays; :func:`~roverlab.viz.config.default_config` when None.
         speed_mps: linear speed of the drive keys (teleop_twist_keyboard's ``~speed``).
         turn_radps: angular speed of the drive keys (``~turn``).
+        map_dir: where the Save map button writes (map_saver's working directory).
+        remote_graph: returns the other processes' publishers and subscriptions
+            (:meth:`Connection.graph`); None in-process.
         node_name: name of the node.
     """
 
@@ -79,35 +205,33 @@ class VizBridge:
         *,
         context: Context,
         fixed_frame: str = "map",
+        config: DashboardConfig | None = None,
         speed_mps: float = 0.3,
         turn_radps: float = 0.5,
+        map_dir: str | Path = ".",
+        remote_graph: Callable[[], Sequence[Any]] | None = None,
         node_name: str = "rviz",
     ) -> None:
         self.context = context
-        self.requested_fixed_frame = fixed_frame
         self.speed_mps = speed_mps
         self.turn_radps = turn_radps
-        self.node = context.create_node(node_name)
+        self.map_dir = Path(map_dir)
+        self.node = RvizNode(node_name, context=context)
         self.tf_buffer = Buffer()
         self._listener = TransformListener(self.tf_buffer, self.node)
         self._lock = threading.Lock()
         self._version = 0
-        self.map_frame: Versioned | None = None
-        self.map_frame_id = "map"
-        self.scan_frame: Versioned | None = None
+        self._remote_graph = remote_graph
+        self._remote: list[Any] = []
+        self._received: dict[str, int] = {}
+        self._rate_samples: dict[str, deque[tuple[float, int]]] = {}
         self.outlines: Versioned | None = None
-        self._odom: Any = None
-        self._image_topic: str | None = None
-        self._image_msg: Versioned | None = None
-        self._image_jpeg: Versioned | None = None
-        self._image_subs: dict[str, Any] = {}
+        self._description_sub: Any = None
+        self._description_topic = ""
+        self.config = config if config is not None else default_config(fixed_frame)
+        self.config_version = 1
+        self.displays: list[DisplayState] = []
         node = self.node
-        node.create_subscription("nav_msgs/msg/OccupancyGrid", "/map", self._on_map, _LATCHED)
-        node.create_subscription("sensor_msgs/msg/LaserScan", "/scan", self._on_scan, 5)
-        node.create_subscription("nav_msgs/msg/Odometry", "/odom", self._on_odom, 5)
-        node.create_subscription(
-            "std_msgs/msg/String", "/robot_description", self._on_description, _LATCHED
-        )
         self.goal_pub = node.create_publisher(
             "geometry_msgs/msg/PoseStamped", "/move_base_simple/goal", 1
         )
@@ -118,6 +242,8 @@ class VizBridge:
             "geometry_msgs/msg/PointStamped", "/clicked_point", 1
         )
         self.cmd_vel_pub = node.create_publisher("geometry_msgs/msg/Twist", "/cmd_vel", 1)
+        node.create_timer(0.1, self._refresh_markers)  # lifetimes and frame-locked markers
+        self._apply(self.config)
 
     # ------------------------------------------------------------------ state
     def _next(self) -> int:
@@ -126,111 +252,414 @@ class VizBridge:
             return self._version
 
     @property
+    def requested_fixed_frame(self) -> str:
+        """The configuration's fixed frame."""
+        return self.config.fixed_frame
+
+    @property
     def fixed_frame(self) -> str:
-        """The requested fixed frame if TF knows it, else ``odom``."""
-        if self.tf_buffer.has_frame(self.requested_fixed_frame):
-            return self.requested_fixed_frame
+        """The requested fixed frame if TF knows it, else ``odom`` (a warning in the status)."""
+        want = self.config.fixed_frame
+        if self.tf_buffer.has_frame(want) or not self.tf_buffer.has_frame("odom"):
+            return want
         return "odom"
 
-    def _lookup(self, frame: str, stamp: Any = None) -> Transform3 | None:
+    def _lookup(self, frame: str, stamp: Time | None = None) -> Transform3 | None:
+        tf, _ = self._lookup_why(frame, stamp)
+        return tf
+
+    def _lookup_why(self, frame: str, stamp: Time | None = None) -> tuple[Transform3 | None, str]:
         fixed = self.fixed_frame
         frame = frame.lstrip("/")
+        if not frame:
+            return None, "message has an empty frame_id"
         if frame == fixed:
-            return Transform3()
-        if stamp is not None:
+            return Transform3(), ""
+        if stamp is not None and stamp.nanoseconds > 0:
             try:
-                return self.tf_buffer.lookup_transform(fixed, frame, stamp)[0]
+                return self.tf_buffer.lookup_transform(fixed, frame, stamp)[0], ""
             except TransformException:
                 pass
         try:
-            return self.tf_buffer.lookup_transform(fixed, frame, Time(0))[0]
-        except TransformException:
-            return None
+            return self.tf_buffer.lookup_transform(fixed, frame, Time(0))[0], ""
+        except TransformException as err:
+            return None, f"For frame [{frame}]: {err}"
+
+    # ---------------------------------------------------------- configuration
+    def set_config(self, config: DashboardConfig) -> None:
+        """Replace the configuration (any thread); applied on the executor thread."""
+        self.config = config
+        self.config_version += 1
+        self.context.executor.call_soon_threadsafe(lambda: self._apply(config))
+
+    def _topic_type(self, display: DisplayConfig) -> str:
+        types = DISPLAY_KINDS[display.kind].types
+        if len(types) <= 1:
+            return types[0] if types else ""
+        known = self.topic_types().get(display.topic)
+        if known in types:
+            return known
+        return COMPRESSED_TYPE if display.topic.endswith("/compressed") else types[0]
+
+    def _apply(self, config: DashboardConfig) -> None:
+        if config is not self.config:
+            return  # a newer configuration is queued behind this one
+        pool = list(self.displays)
+        fresh: list[DisplayState] = []
+        for slot, cfg in enumerate(config.displays):
+            key = ("", "")
+            if cfg.enabled and cfg.topic and DISPLAY_KINDS[cfg.kind].types:
+                key = (cfg.topic, self._topic_type(cfg))
+            prev = next((d for d in pool if d.kind == cfg.kind and d.sub_key == key), None)
+            if prev is not None:  # same kind on the same topic: keep its data
+                pool.remove(prev)
+                prev.slot, prev.config = slot, cfg
+                self._configure(prev)
+                fresh.append(prev)
+                continue
+            state = DisplayState(slot=slot, config=cfg, sub_key=key)
+            self._configure(state)
+            if key != ("", ""):
+                try:
+                    state.sub = self._subscribe(state, key)
+                except RoverlabError as err:  # e.g. the topic carries another type
+                    state.error = str(err)
+            fresh.append(state)
+        for d in pool:
+            d.sub_key = ("", "")
+            if d.sub is not None:
+                self.node.destroy_subscription(d.sub)
+                d.sub = None
+        self.displays = fresh
+        self._apply_description(config)
+
+    def _configure(self, state: DisplayState) -> None:
+        cfg = state.config
+        if cfg.kind == "odometry":
+            keep = int(cfg.option("keep"))
+            trail = state.trail or PoseTrail()
+            trail.keep = keep
+            trail.position_tolerance_m = float(cfg.option("position_tolerance"))
+            trail.angle_tolerance_rad = float(cfg.option("angle_tolerance"))
+            state.trail = trail
+        if cfg.kind in ("marker", "marker_array") and state.markers is None:
+            state.markers = MarkerStore(self._lookup)
+
+    def _apply_description(self, config: DashboardConfig) -> None:
+        robots = [d for d in config.displays if d.kind == "robot_model" and d.enabled]
+        topic = robots[0].topic or "/robot_description" if robots else ""
+        if topic == self._description_topic:
+            return
+        if self._description_sub is not None:
+            self.node.destroy_subscription(self._description_sub)
+            self._description_sub = None
+        self._description_topic = topic
+        self.outlines = None
+        if topic:
+            self._description_sub = self.node.create_subscription(
+                "std_msgs/msg/String", topic, self._on_description, _LATCHED
+            )
+
+    def _subscribe(self, state: DisplayState, key: tuple[str, str]) -> Any:
+        topic, typename = key
+        kind = state.kind
+        handlers: dict[str, Callable[[DisplayState, Any], None]] = {
+            "map": self._on_map,
+            "laser_scan": self._on_scan,
+            "point_cloud2": self._on_cloud,
+            "odometry": self._on_odom,
+            "path": self._on_path,
+            "pose_array": self._on_pose_array,
+            "pose": self._on_pose,
+            "marker": self._on_marker,
+            "marker_array": self._on_marker_array,
+            "image": self._on_image,
+        }
+        handler = handlers[kind]
+
+        def callback(msg: Any) -> None:
+            if state.sub_key != key:
+                return
+            state.received += 1
+            self._received[topic] = self._received.get(topic, 0) + 1
+            try:
+                handler(state, msg)
+                state.error = None
+            except (RoverlabError, ValueError, OSError) as err:
+                state.error = f"{type(err).__name__}: {err}"
+
+        qos: QoSProfile | int = _LATCHED if kind == "map" else (1 if kind == "image" else 10)
+        return self.node.create_subscription(typename, topic, callback, qos)
 
     # -------------------------------------------------------------- callbacks
-    def _on_map(self, msg: Any) -> None:
+    def _tf_status(self, state: DisplayState, tf: Transform3 | None, why: str) -> bool:
+        if tf is None:
+            state.status["Transform"] = ("error", why)
+            return False
+        state.status["Transform"] = ("ok", "Transform OK")
+        return True
+
+    def _on_map(self, state: DisplayState, msg: Any) -> None:
+        state.map_msg = msg
         cells = occupancy_grid_to_array(msg)
         o = msg.info.origin
-        origin = (
-            float(o.position.x),
-            float(o.position.y),
-            yaw_from_quaternion(o.orientation),
-        )
-        frame = encode_map(cells, resolution_m=float(msg.info.resolution), origin=origin)
-        self.map_frame_id = str(msg.header.frame_id).lstrip("/") or "map"
-        self.map_frame = Versioned(self._next(), frame)
+        origin = (float(o.position.x), float(o.position.y), yaw_from_quaternion(o.orientation))
+        res = float(msg.info.resolution)
+        frame_id = str(msg.header.frame_id).lstrip("/") or "map"
+        key = (cells.shape, res, origin, frame_id)
+        height, width = cells.shape
+        state.info = {"frame": frame_id, "width": int(width), "height": int(height)}
+        prev = state.map_cells
+        if state.map_base is not None and key == state.map_key and prev is not None:
+            change = map_change(prev, cells)
+            if change is None:
+                return
+            x0, y0, window = change
+            if len(state.map_patches) < _MAX_PATCHES and window.size * 2 < cells.size:
+                state.map_cells = cells
+                patch = Versioned(self._next(), encode_map_patch(window, x0, y0))
+                state.map_patches = [*state.map_patches, patch]
+                state.frame = patch
+                return
+        frame = Versioned(self._next(), encode_map(cells, resolution_m=res, origin=origin))
+        state.map_cells = cells
+        state.map_key = key
+        state.map_patches = []
+        state.map_base = frame
+        state.frame = frame
 
-    def _on_scan(self, msg: Any) -> None:
-        pts = scan_to_points(msg)
-        stamp = Time(int(msg.header.stamp.sec) * 1_000_000_000 + int(msg.header.stamp.nanosec))
-        tf = self._lookup(str(msg.header.frame_id), stamp)
-        if tf is None:
+    def _on_scan(self, state: DisplayState, msg: Any) -> None:
+        cfg = state.config
+        tf, why = self._lookup_why(str(msg.header.frame_id), _stamp_time(msg.header))
+        if not self._tf_status(state, tf, why):
             return
+        assert tf is not None
+        pts = scan_to_points(msg)
         world = tf.apply(np.column_stack((pts, np.zeros(len(pts)))))[:, :2]
-        self.scan_frame = Versioned(self._next(), encode_scan(world))
+        values = None
+        if cfg.option("color_transformer") == "Intensity" and len(msg.intensities) > 0:
+            rng = np.asarray(msg.ranges, dtype=np.float64)
+            ok = np.isfinite(rng) & (rng >= msg.range_min) & (rng <= msg.range_max)
+            inten = np.asarray(msg.intensities, dtype=np.float64)
+            if len(inten) == len(rng):
+                values = inten[ok]
+        idx, palette = color_buckets(
+            str(cfg.option("color_transformer")),
+            count=len(world),
+            flat_rgb=_rgb(cfg),
+            alpha=float(cfg.option("alpha")),
+            values=values if values is not None and len(values) == len(world) else None,
+        )
+        state.frame = Versioned(self._next(), encode_points(world, idx, palette))
 
-    def _on_odom(self, msg: Any) -> None:
-        self._odom = msg
+    def _on_cloud(self, state: DisplayState, msg: Any) -> None:
+        cfg = state.config
+        tf, why = self._lookup_why(str(msg.header.frame_id), _stamp_time(msg.header))
+        if not self._tf_status(state, tf, why):
+            return
+        assert tf is not None
+        xyz = pointcloud2_to_xyz(msg, skip_nans=True)
+        xyz = decimate(xyz, int(cfg.option("max_points")))
+        world = tf.apply(xyz.astype(np.float64))
+        idx, palette = color_buckets(
+            str(cfg.option("color_transformer")),
+            count=len(world),
+            flat_rgb=_rgb(cfg),
+            alpha=float(cfg.option("alpha")),
+            values=world[:, 2],
+        )
+        state.info = {"points": len(world)}
+        state.frame = Versioned(self._next(), encode_points(world[:, :2], idx, palette))
+
+    def _posed(self, state: DisplayState, header: Any, poses: Sequence[Any]) -> np.ndarray | None:
+        tf, why = self._lookup_why(str(header.frame_id), _stamp_time(header))
+        if not self._tf_status(state, tf, why):
+            return None
+        assert tf is not None
+        pos = np.array([(p.position.x, p.position.y, p.position.z) for p in poses], dtype=float)
+        quat = np.array(
+            [(p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w) for p in poses],
+            dtype=float,
+        )
+        return poses_in_fixed(tf, pos.reshape(-1, 3), quat.reshape(-1, 4))
+
+    def _on_odom(self, state: DisplayState, msg: Any) -> None:
+        arr = self._posed(state, msg.header, [msg.pose.pose])
+        if arr is None or state.trail is None:
+            return
+        if state.trail.add(float(arr[0, 0]), float(arr[0, 1]), float(arr[0, 2])):
+            state.frame = Versioned(self._next(), encode_poses(state.trail.array()))
+
+    def _on_path(self, state: DisplayState, msg: Any) -> None:
+        arr = self._posed(state, msg.header, [p.pose for p in msg.poses])
+        if arr is None:
+            return
+        state.frame = Versioned(self._next(), encode_path(arr[:, :2]))
+
+    def _on_pose_array(self, state: DisplayState, msg: Any) -> None:
+        arr = self._posed(state, msg.header, list(msg.poses))
+        if arr is None:
+            return
+        state.frame = Versioned(self._next(), encode_poses(arr))
+
+    def _on_pose(self, state: DisplayState, msg: Any) -> None:
+        arr = self._posed(state, msg.header, [msg.pose])
+        if arr is not None:
+            state.frame = Versioned(self._next(), encode_poses(arr))
+
+    def _markers_changed(self, state: DisplayState) -> None:
+        assert state.markers is not None
+        state.frame = Versioned(self._next(), json.dumps(state.markers.primitives()))
+        errors = state.markers.errors
+        if errors:
+            name, why = next(iter(errors.items()))
+            state.status["Transform"] = ("error", f"marker {name}: {why}")
+        else:
+            state.status["Transform"] = ("ok", "Transform OK")
+
+    def _refresh_markers(self) -> None:
+        now_ns = self.context.now().nanoseconds
+        for d in self.displays:
+            if d.markers is not None and d.markers.refresh(now_ns):
+                self._markers_changed(d)
+
+    def _on_marker(self, state: DisplayState, msg: Any) -> None:
+        assert state.markers is not None
+        state.markers.add(msg, self.context.now().nanoseconds)
+        self._markers_changed(state)
+
+    def _on_marker_array(self, state: DisplayState, msg: Any) -> None:
+        assert state.markers is not None
+        now = self.context.now().nanoseconds
+        for m in msg.markers:
+            state.markers.add(m, now)
+        self._markers_changed(state)
+
+    def _on_image(self, state: DisplayState, msg: Any) -> None:
+        state.image_msg = Versioned(self._next(), msg)
 
     def _on_description(self, msg: Any) -> None:
-        model = parse_urdf(str(msg.data), source="/robot_description")
+        model = parse_urdf(str(msg.data), source=self._description_topic)
         self.outlines = Versioned(self._next(), robot_outlines(model))
 
-    def _on_image(self, topic: str, msg: Any) -> None:
-        if topic == self._image_topic:
-            self._image_msg = Versioned(self._next(), msg)
-
     # ---------------------------------------------------------------- queries
+    def refresh_remote_graph(self) -> None:
+        """Ask the other processes for their publishers and subscriptions (blocking)."""
+        if self._remote_graph is not None:
+            self._remote = list(self._remote_graph())
+
+    def topics(self) -> list[TopicInfo]:
+        """Every topic of the running system (this process's and, when attached over the
+        network, the others'), with publisher and subscriber counts."""
+        pubs: dict[str, int] = {}
+        subs: dict[str, int] = {}
+        types: dict[str, str] = {}
+        for name, t in list(self.context.graph.topics.items()):
+            types[name] = t.typename
+            pubs[name] = pubs.get(name, 0) + len(t.publishers)
+            own = sum(1 for s in t.subscriptions if s.node is self.node)
+            subs[name] = subs.get(name, 0) + len(t.subscriptions) - own
+        for e in self._remote:
+            if e.kind not in ("publisher", "subscription") or not e.topic:
+                continue
+            types.setdefault(e.topic, e.typename)
+            if e.kind == "publisher":
+                pubs[e.topic] = pubs.get(e.topic, 0) + 1
+            else:
+                subs[e.topic] = subs.get(e.topic, 0) + 1
+        return [TopicInfo(n, types[n], pubs.get(n, 0), subs.get(n, 0)) for n in sorted(types)]
+
+    def topic_types(self) -> dict[str, str]:
+        """Topic -> message type, of the whole system."""
+        return {t.name: t.typename for t in self.topics()}
+
     def image_topics(self) -> list[str]:
-        """Topics of type ``sensor_msgs/msg/Image`` in the graph."""
-        graph = self.context.graph.topics
-        return sorted(name for name, t in list(graph.items()) if t.typename == IMAGE_TYPE)
+        """Topics of type ``sensor_msgs/msg/Image`` or ``CompressedImage`` with a publisher."""
+        return sorted(
+            t.name
+            for t in self.topics()
+            if t.typename in (IMAGE_TYPE, COMPRESSED_TYPE) and t.publishers > 0
+        )
+
+    def topic_rates(self) -> dict[str, float | None]:
+        """Messages per wall second of each topic over the last few seconds (None: not
+        measurable: no local publisher and the dashboard does not subscribe to it)."""
+        now = time.monotonic()
+        out: dict[str, float | None] = {}
+        for name, t in list(self.context.graph.topics.items()):
+            count = t.published if t.publishers else self._received.get(name)
+            if count is None:
+                out[name] = None
+                continue
+            samples = self._rate_samples.setdefault(name, deque())
+            samples.append((now, count))
+            while len(samples) > 2 and now - samples[0][0] > _RATE_WINDOW_S:
+                samples.popleft()
+            t0, c0 = samples[0]
+            out[name] = round((count - c0) / (now - t0), 2) if now - t0 > 0.2 else None
+        return out
 
     def select_image(self, topic: str) -> None:
-        """Show ``topic`` in the image panel (subscribed on first use; any thread)."""
-        self._image_topic = topic
-        self._image_msg = None
-        if topic in self._image_subs:
-            return
+        """Show ``topic`` in the first image display (created if there is none)."""
+        displays = [
+            DisplayConfig(d.kind, d.name, d.enabled, d.topic, dict(d.options))
+            for d in self.config.displays
+        ]
+        images = [d for d in displays if d.kind == "image"]
+        if images:
+            images[0].topic = topic
+            images[0].enabled = True
+        else:
+            displays.append(DisplayConfig("image", "Image", True, topic, {}))
+        self.set_config(
+            DashboardConfig(
+                self.config.fixed_frame, displays, list(self.config.unsupported), self.config.source
+            )
+        )
 
-        def subscribe() -> None:
-            if self._image_subs.get(topic) is None:
-                self._image_subs[topic] = self.node.create_subscription(
-                    IMAGE_TYPE, topic, lambda m: self._on_image(topic, m), 1
-                )
-
-        self._image_subs[topic] = None  # claimed; the executor thread fills it in
-        self.context.executor.call_soon_threadsafe(subscribe)
-
-    def image_frame(self) -> Versioned | None:
-        """The newest image of the selected topic as a JPEG frame (encoded once)."""
-        msg = self._image_msg
+    def image_frame(self, state: DisplayState) -> Versioned | None:
+        """The newest image of an image display as a JPEG/PNG frame (encoded once)."""
+        msg = state.image_msg
         if msg is None:
             return None
-        cached = self._image_jpeg
+        cached = state.image_jpeg
         if cached is not None and cached.version == msg.version:
             return cached
-        rgb = image_to_rgb8(image_to_array(msg.payload), str(msg.payload.encoding))
-        frame = Versioned(msg.version, encode_image(rgb))
-        self._image_jpeg = frame
+        try:
+            payload = self._encode_image(state.config, msg.payload)
+            state.error = None
+        except (RoverlabError, ValueError, OSError) as err:
+            state.error = f"cannot show the image: {err}"
+            return None
+        frame = Versioned(msg.version, payload)
+        state.image_jpeg = frame
         return frame
 
-    def state(self) -> dict[str, Any]:
-        """Small per-tick state: fixed frame, frame axes, odometry arrow, robot outline."""
+    @staticmethod
+    def _encode_image(cfg: DisplayConfig, msg: Any) -> bytes:
+        cmap = str(cfg.option("color_map"))
+        lo, hi = float(cfg.option("min_value")), float(cfg.option("max_value"))
+        if hasattr(msg, "encoding"):
+            pixels = image_to_array(msg)
+            return encode_image(
+                image_to_rgb8(pixels, str(msg.encoding), color_map=cmap, min_value=lo, max_value=hi)
+            )
+        data = bytes(memoryview(msg.data))
+        fmt = str(msg.format).lower()
+        if "compresseddepth" in fmt:  # image_transport's compressedDepth: 12-byte header + PNG
+            depth = np.asarray(Image.open(io.BytesIO(data[12:])))
+            rgb = colorize(depth, cmap, min_value=lo, max_value=hi, invalid_zero=True)
+            return encode_image(rgb)
+        return encode_image_file(data)
+
+    def state(self, *, with_topics: bool = False) -> dict[str, Any]:
+        """Small per-tick state: frames, robot outline, per-display info and status."""
         fixed = self.fixed_frame
         frames: dict[str, list[float]] = {}
         for name in self.tf_buffer.frames():
             tf = self._lookup(name)
             if tf is not None:
                 frames[name] = _xyyaw(tf)
-        odom = None
-        msg = self._odom
-        if msg is not None:
-            tf = self._lookup(str(msg.header.frame_id))
-            if tf is not None:
-                p, q = msg.pose.pose.position, msg.pose.pose.orientation
-                pose = tf * Transform3((float(p.x), float(p.y), float(p.z)), (q.x, q.y, q.z, q.w))
-                odom = _xyyaw(pose)
         robot: list[dict[str, Any]] = []
         outlines: list[VisualOutline] = self.outlines.payload if self.outlines else []
         for outline in outlines:
@@ -239,20 +668,105 @@ class VizBridge:
                 continue
             poly = outline.footprint(tf)
             robot.append(
-                {
-                    "rgba": outline.rgba,
-                    "points": [[round(x, 4), round(y, 4)] for x, y in poly],
-                }
+                {"rgba": outline.rgba, "points": [[round(x, 4), round(y, 4)] for x, y in poly]}
             )
-        return {
+        out: dict[str, Any] = {
             "type": "state",
             "fixed_frame": fixed,
-            "map_frame": self.map_frame_id,
             "frames": frames,
-            "odom": odom,
             "robot": robot,
+            "displays": [d.info for d in self.displays],
+            "status": self.status(frames, outlines),
             "image_topics": self.image_topics(),
+            "drive": {"speed": round(self.speed_mps, 4), "turn": round(self.turn_radps, 4)},
+            "config_version": self.config_version,
         }
+        if with_topics:
+            rates = self.topic_rates()
+            out["topics"] = [
+                {
+                    "name": t.name,
+                    "type": t.typename,
+                    "publishers": t.publishers,
+                    "subscribers": t.subscribers,
+                    "hz": rates.get(t.name),
+                }
+                for t in self.topics()
+            ]
+        return out
+
+    def status(
+        self, frames: dict[str, list[float]], outlines: list[VisualOutline]
+    ) -> dict[str, Any]:
+        """The status tree: ``{"global": [[level, name, text], ...], "displays": [...]}``."""
+        infos = {t.name: t for t in self.topics()}
+        want = self.config.fixed_frame
+        glob: list[list[str]] = []
+        if self.tf_buffer.has_frame(want):
+            glob.append(["ok", "Fixed Frame", "OK"])
+        elif self.fixed_frame != want:
+            glob.append(
+                ["warn", "Fixed Frame", f"Fixed Frame [{want}] does not exist; drawing in [odom]"]
+            )
+        else:
+            glob.append(["error", "Fixed Frame", f"Fixed Frame [{want}] does not exist"])
+        for item in self.config.unsupported:
+            glob.append(["warn", "Unsupported display", f"{item} is not supported; skipped"])
+        rows: list[list[list[str]]] = []
+        for d in self.displays:
+            cfg = d.config
+            entries: list[list[str]] = []
+            if not cfg.enabled:
+                rows.append([["disabled", "Status", "disabled"]])
+                continue
+            if d.sub_key[0]:
+                info = infos.get(cfg.topic)
+                types = DISPLAY_KINDS[cfg.kind].types
+                if info is not None and info.typename not in types:
+                    entries.append(
+                        ["error", "Topic", f"{cfg.topic} carries {info.typename}, not {types[0]}"]
+                    )
+                elif info is None or info.publishers == 0:
+                    text = f"No publisher on {cfg.topic}"
+                    if d.received:
+                        text += f" ({d.received} messages received)"
+                    entries.append(["warn", "Topic", text])
+                elif d.received == 0:
+                    entries.append(["warn", "Topic", f"No messages received on {cfg.topic}"])
+                else:
+                    entries.append(["ok", "Topic", f"{d.received} messages received"])
+            elif cfg.kind == "robot_model":
+                if not outlines:
+                    entries.append(["warn", "URDF", f"No robot description on {cfg.topic}"])
+                else:
+                    missing = sorted({o.link for o in outlines} - set(frames) - {self.fixed_frame})
+                    if missing:
+                        entries.append(
+                            ["error", "Transform", f"No transform for link(s) {', '.join(missing)}"]
+                        )
+                    else:
+                        entries.append(["ok", "URDF", f"{len(outlines)} visuals"])
+            elif cfg.kind == "grid":
+                ref = str(cfg.option("reference_frame"))
+                if ref and ref not in frames and ref != self.fixed_frame:
+                    entries.append(["error", "Transform", f"Frame [{ref}] does not exist"])
+                else:
+                    entries.append(["ok", "Status", "OK"])
+            elif cfg.kind == "tf":
+                entries.append(["ok", "Frames", f"{len(frames)} frames"])
+            frame = d.info.get("frame") if cfg.kind == "map" else None
+            if frame and frame not in frames and frame != self.fixed_frame:
+                entries.append(
+                    ["error", "Transform", f"No transform from [{frame}] to [{self.fixed_frame}]"]
+                )
+            elif frame:
+                entries.append(["ok", "Transform", "Transform OK"])
+            for name, (level, text) in d.status.items():
+                entries.append([level, name, text])
+            if d.error:
+                entries.append(["error", "Message", d.error])
+            rows.append(entries)
+        return {"global": glob, "displays": rows}
 
     # ------------------------------------------------------------------ tools
     def _header(self) -> dict[str, Any]:
@@ -280,9 +794,59 @@ class VizBridge:
         )
 
     def drive_key(self, key: str) -> bool:
-        """A teleop key (``i j l , k`` ...): its Twist on ``/cmd_vel``. False if ignored."""
+        """A teleop key: ``i j l , k u o m .`` (and the holonomic capitals) publish their
+        Twist on ``/cmd_vel``; ``q z w x e c`` scale the speeds by 10 % as
+        teleop_twist_keyboard does. False if the key means nothing."""
+        if key in SPEED_BINDINGS:
+            fs, ft = SPEED_BINDINGS[key]
+            self.speed_mps *= fs
+            self.turn_radps *= ft
+            return True
         cmd = twist_for_key(key, self.speed_mps, self.turn_radps)
         if cmd is None:
             return False
         self.cmd_vel_pub.publish(command_to_twist(cmd))
         return True
+
+    def set_speeds(self, speed_mps: float, turn_radps: float) -> None:
+        """The drive panel's speed controls (``~speed`` and ``~turn``).
+
+        Raises:
+            DashboardError: a speed that is negative or not finite.
+        """
+        for name, v in (("speed", speed_mps), ("turn", turn_radps)):
+            if not (math.isfinite(v) and v >= 0):
+                raise DashboardError(f"{name} must be a finite number >= 0, got {v}")
+        self.speed_mps, self.turn_radps = speed_mps, turn_radps
+
+    def save_map(self, name: str = "map") -> Path:
+        """map_saver of the newest map: ``map_dir/NAME.pgm`` + ``NAME.yaml``.
+
+        The map comes from the first map display on ``/map`` (else the first map display
+        with data).
+
+        Raises:
+            DashboardError: a bad name, no map received yet, or the files cannot be written.
+        """
+        if not _MAP_NAME.match(name) or name.startswith("."):
+            raise DashboardError(f"bad map name {name!r}: use letters, digits, '_', '-', '.'")
+        maps = [d for d in self.displays if d.kind == "map" and d.map_msg is not None]
+        maps.sort(key=lambda d: d.config.topic != "/map")
+        if not maps:
+            raise DashboardError("no map received yet: nothing to save")
+        msg = maps[0].map_msg
+        o = msg.info.origin
+        try:
+            saved = save_map(
+                self.map_dir / name,
+                occupancy_grid_to_array(msg),
+                resolution=float(msg.info.resolution),
+                origin=(
+                    float(o.position.x),
+                    float(o.position.y),
+                    yaw_from_quaternion(o.orientation),
+                ),
+            )
+        except RoverlabError as err:
+            raise DashboardError(f"cannot save the map: {err}") from err
+        return saved.yaml_path

@@ -1,11 +1,21 @@
 """``DashboardServer``: rviz in the browser, served by FastAPI + uvicorn in one thread.
 
 One page (``static/index.html`` + ``static/app.js``, no build step) and one websocket at
-``/ws``. The server pushes binary frames (map, scan, camera JPEG; see
-:mod:`roverlab.viz.protocol`) only when their data changed, and a JSON ``state`` message
-at :attr:`DashboardServer.state_rate_hz`. The page sends JSON tool messages back:
-``{"type": "goal" | "initialpose", "x", "y", "yaw"}``, ``{"type": "point", "x", "y"}``,
-``{"type": "key", "key": "i"}`` and ``{"type": "image_topic", "topic": "/image_raw"}``.
+``/ws``. The server pushes each display's binary frame (map or map patch, points, poses,
+path, camera image; see :mod:`roverlab.viz.protocol`) only when its data changed, marker
+lists as JSON ``{"type": "markers", "slot", "items"}``, the configuration as JSON
+``{"type": "config", "config"}`` whenever it changes, and a JSON ``state`` message (frames,
+robot outline, status tree; the topic list with rates once a second) at
+:attr:`DashboardServer.state_rate_hz`.
+
+The page sends JSON back: tools ``{"type": "goal" | "initialpose", "x", "y", "yaw"}``,
+``{"type": "point", "x", "y"}``; drive ``{"type": "key", "key": "i"}``,
+``{"type": "speed", "speed", "turn"}``; ``{"type": "config", "config": {...}}`` (the
+whole configuration, :meth:`DashboardConfig.to_dict` form), ``{"type": "save_config"}``,
+``{"type": "save_map", "name": "map"}`` and ``{"type": "image_topic", "topic"}``. Replies
+to a save come back as ``{"type": "notice", "level", "text"}``.
+
+The configuration is shared by every page of one server (like one rviz window).
 
 Security: on a loopback host no token is needed. Any other host requires a token (made up
 and printed once when not given), asked for by the page URL (``/?token=...``) and the
@@ -20,9 +30,12 @@ import hmac
 import ipaddress
 import json
 import secrets
+import socket
+import struct
 import sys
 import threading
 import time
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, Final
 
@@ -32,13 +45,18 @@ from fastapi.responses import FileResponse, PlainTextResponse, Response
 from fastapi.staticfiles import StaticFiles
 
 from roverlab.core import Context
-from roverlab.viz.bridge import Versioned, VizBridge
+from roverlab.errors import RoverlabError
+from roverlab.viz.bridge import DisplayState, VizBridge
+from roverlab.viz.config import DashboardConfig, config_from_dict, save_config
 from roverlab.viz.errors import DashboardError
 
 __all__ = ["DashboardServer", "is_loopback"]
 
 STATIC_DIR: Final = Path(__file__).parent / "static"
 _START_TIMEOUT_S: Final = 10.0
+_TOPICS_EVERY_S: Final = 1.0
+_REMOTE_GRAPH_EVERY_S: Final = 2.0
+DEFAULT_CONFIG_NAME: Final = "dashboard.json"
 
 
 def is_loopback(host: str) -> bool:
@@ -66,8 +84,16 @@ class DashboardServer:
         host: address to bind; anything but loopback requires a token.
         port: TCP port (0 picks a free one; see :attr:`port` after :meth:`start`).
         token: access token; made up when binding a non-loopback host without one.
-        fixed_frame: the displays' fixed frame (``odom`` while TF does not know it).
+        fixed_frame: the displays' fixed frame when ``config`` is not given.
+        config: the displays (from :func:`~roverlab.viz.config.load_config`); the
+            default set when None.
+        config_path: where the page's *Save config* writes (the dashboard's JSON); by
+            default the loaded file if it was one of ours, else ``./dashboard.json``.
+        map_dir: where the page's *Save map* writes ``NAME.pgm`` + ``NAME.yaml``.
+        remote_graph: the other processes' graph (:meth:`Connection.graph`), polled
+            every 2 s for the topic list; None in-process.
         state_rate_hz: how often poses and the robot outline are sent.
+        node_name: the dashboard node's name (destroying it stops the server).
 
     Raises:
         DashboardError: ``port`` out of range or ``state_rate_hz`` not positive.
@@ -81,7 +107,12 @@ class DashboardServer:
         token: str | None = None,
         *,
         fixed_frame: str = "map",
+        config: DashboardConfig | None = None,
+        config_path: str | Path | None = None,
+        map_dir: str | Path = ".",
+        remote_graph: Callable[[], Sequence[Any]] | None = None,
         state_rate_hz: float = 10.0,
+        node_name: str = "rviz",
     ) -> None:
         if not 0 <= port <= 65535:
             raise DashboardError(f"port must be 0..65535, got {port}")
@@ -92,10 +123,26 @@ class DashboardServer:
         self.generated_token = token is None and not is_loopback(host)
         self.token = secrets.token_urlsafe(16) if self.generated_token else token
         self.state_rate_hz = state_rate_hz
-        self.bridge = VizBridge(context=context, fixed_frame=fixed_frame)
+        if config_path is None:
+            src = Path(config.source) if config is not None and config.source else None
+            ours = src is not None and src.suffix == ".json"
+            config_path = src if ours and src is not None else Path(DEFAULT_CONFIG_NAME)
+        self.config_path = Path(config_path)
+        self.bridge = VizBridge(
+            context=context,
+            fixed_frame=fixed_frame,
+            config=config,
+            map_dir=map_dir,
+            remote_graph=remote_graph,
+            node_name=node_name,
+        )
+        self.bridge.node.on_destroy.append(self.stop)
+        self.bridge.node.server = self
         self.app = self._make_app()
         self._server: uvicorn.Server | None = None
         self._thread: threading.Thread | None = None
+        self._graph_thread: threading.Thread | None = None
+        self._stopping = threading.Event()
 
     # ------------------------------------------------------------------ HTTP
     def _authorised(self, given: str | None) -> bool:
@@ -112,6 +159,16 @@ class DashboardServer:
                 return PlainTextResponse("forbidden: wrong or missing token", status_code=403)
             return FileResponse(STATIC_DIR / "index.html", headers={"Cache-Control": "no-store"})
 
+        @app.get("/config")
+        def config(request: Request) -> Response:
+            if not self._authorised(request.query_params.get("token")):
+                return PlainTextResponse("forbidden: wrong or missing token", status_code=403)
+            return Response(
+                json.dumps(self.bridge.config.to_dict(), indent=2),
+                media_type="application/json",
+                headers={"Content-Disposition": f'attachment; filename="{DEFAULT_CONFIG_NAME}"'},
+            )
+
         app.mount("/static", StaticFiles(directory=STATIC_DIR), name="static")
 
         @app.websocket("/ws")
@@ -126,12 +183,18 @@ class DashboardServer:
 
     # ------------------------------------------------------------- websocket
     async def _serve_client(self, websocket: WebSocket) -> None:
-        sender = asyncio.create_task(self._send_loop(websocket))
+        replies: asyncio.Queue[dict[str, Any]] = asyncio.Queue()
+        sender = asyncio.create_task(self._send_loop(websocket, replies))
         try:
             while True:
                 text = await websocket.receive_text()
-                with contextlib.suppress(ValueError, KeyError, TypeError):
-                    self._handle(json.loads(text))
+                try:
+                    msg = json.loads(text)
+                    reply = await asyncio.to_thread(self._handle, msg)
+                except (ValueError, KeyError, TypeError, RoverlabError) as err:
+                    reply = {"type": "notice", "level": "error", "text": str(err)}
+                if reply is not None:
+                    replies.put_nowait(reply)
         except WebSocketDisconnect:
             pass
         finally:
@@ -139,7 +202,13 @@ class DashboardServer:
             with contextlib.suppress(asyncio.CancelledError, Exception):
                 await sender
 
-    def _handle(self, msg: dict[str, Any]) -> None:
+    def _handle(self, msg: dict[str, Any]) -> dict[str, Any] | None:
+        """One message from a page; returns the reply for that page, if any.
+
+        Raises:
+            ValueError, KeyError, TypeError, RoverlabError: a malformed message or a
+                failed action (the page is told).
+        """
         kind = msg.get("type")
         bridge = self.bridge
         if kind == "goal":
@@ -150,34 +219,103 @@ class DashboardServer:
             bridge.publish_point(_number(msg, "x"), _number(msg, "y"))
         elif kind == "key":
             bridge.drive_key(str(msg["key"])[:1])
+        elif kind == "speed":
+            bridge.set_speeds(_number(msg, "speed"), _number(msg, "turn"))
         elif kind == "image_topic":
-            topic = str(msg["topic"])
-            if topic in bridge.image_topics():
-                bridge.select_image(topic)
+            bridge.select_image(str(msg["topic"]))
+        elif kind == "config":
+            bridge.set_config(config_from_dict(msg["config"], "configuration from the page"))
+        elif kind == "save_config":
+            path = save_config(bridge.config, self.config_path)
+            return {"type": "notice", "level": "ok", "text": f"saved the configuration to {path}"}
+        elif kind == "save_map":
+            path = bridge.save_map(str(msg.get("name") or "map"))
+            return {"type": "notice", "level": "ok", "text": f"saved the map to {path}"}
+        return None
 
-    async def _send_loop(self, websocket: WebSocket) -> None:
+    @staticmethod
+    def _slotted(payload: bytes, slot: int) -> bytes:
+        return payload[:2] + struct.pack("<H", slot) + payload[4:]
+
+    async def _send_display(
+        self, websocket: WebSocket, d: DisplayState, sent: dict[tuple[int, int], int]
+    ) -> None:
+        key = (id(d), d.slot)
+        have = sent.get(key)
+        if d.kind == "map":
+            base = d.map_base
+            if base is None:
+                return
+            patches = d.map_patches
+            current = patches[-1].version if patches else base.version
+            if have == current:
+                return
+            known = have is not None and (
+                have == base.version or any(p.version == have for p in patches)
+            )
+            if not known:
+                await websocket.send_bytes(self._slotted(base.payload, d.slot))
+                have = base.version
+            for p in patches:
+                if have is not None and p.version > have:
+                    await websocket.send_bytes(self._slotted(p.payload, d.slot))
+            sent[key] = current
+            return
+        if d.kind == "image":
+            item = d.image_jpeg
+            if d.image_msg is not None and (item is None or item.version != d.image_msg.version):
+                if sent.get(key) == d.image_msg.version:
+                    return
+                item = await asyncio.to_thread(self.bridge.image_frame, d)
+        else:
+            item = d.frame
+        if item is None or have == item.version:
+            return
+        sent[key] = item.version
+        if isinstance(item.payload, str):
+            await websocket.send_text(
+                f'{{"type": "markers", "slot": {d.slot}, "items": {item.payload}}}'
+            )
+        else:
+            await websocket.send_bytes(self._slotted(item.payload, d.slot))
+
+    async def _send_loop(
+        self, websocket: WebSocket, replies: asyncio.Queue[dict[str, Any]]
+    ) -> None:
         bridge = self.bridge
-        sent: dict[str, int] = {}
+        sent: dict[tuple[int, int], int] = {}
         period = 1.0 / self.state_rate_hz
-        next_state = 0.0
-        map_frame_id = ""
-
-        async def send_new(key: str, item: Versioned | None) -> None:
-            if item is not None and sent.get(key) != item.version:
-                sent[key] = item.version
-                await websocket.send_bytes(item.payload)
-
+        next_state = next_topics = 0.0
+        config_version = 0
+        displays: list[DisplayState] = []
         while True:
-            if bridge.map_frame_id != map_frame_id and bridge.map_frame is not None:
-                map_frame_id = bridge.map_frame_id
-                sent.pop("map", None)
-            await send_new("map", bridge.map_frame)
-            await send_new("scan", bridge.scan_frame)
-            await send_new("image", await asyncio.to_thread(bridge.image_frame))
+            while not replies.empty():
+                await websocket.send_text(json.dumps(replies.get_nowait()))
+            if bridge.config_version != config_version or bridge.displays is not displays:
+                config_version = bridge.config_version
+                displays = bridge.displays
+                # a display that moved to another slot is resent under its new number
+                live = {(id(d), d.slot) for d in displays}
+                sent = {k: v for k, v in sent.items() if k in live}
+                await websocket.send_text(
+                    json.dumps(
+                        {
+                            "type": "config",
+                            "version": config_version,
+                            "config": bridge.config.to_dict(),
+                        }
+                    )
+                )
+            for d in displays:
+                if d.config.enabled:
+                    await self._send_display(websocket, d, sent)
             now = time.monotonic()
             if now >= next_state:
                 next_state = now + period
-                state = await asyncio.to_thread(bridge.state)
+                with_topics = now >= next_topics
+                if with_topics:
+                    next_topics = now + _TOPICS_EVERY_S
+                state = await asyncio.to_thread(bridge.state, with_topics=with_topics)
                 await websocket.send_text(json.dumps(state))
             await asyncio.sleep(0.02)
 
@@ -197,28 +335,57 @@ class DashboardServer:
         """
         if self._thread is not None:
             raise DashboardError("dashboard already started")
-        config = uvicorn.Config(
-            self.app, host=self.host, port=self.port, log_level="warning", ws="websockets-sansio"
-        )
+        sock = self._listen()
+        self.port = int(sock.getsockname()[1])
+        config = uvicorn.Config(self.app, log_level="warning", ws="websockets-sansio")
         server = uvicorn.Server(config)
         self._server = server
-        self._thread = threading.Thread(target=server.run, name="roverlab-dashboard", daemon=True)
+        self._thread = threading.Thread(
+            target=server.run, kwargs={"sockets": [sock]}, name="roverlab-dashboard", daemon=True
+        )
         self._thread.start()
         deadline = time.monotonic() + _START_TIMEOUT_S
         while not server.started:
             if not self._thread.is_alive() or time.monotonic() > deadline:
-                raise DashboardError(f"dashboard could not listen on {self.host}:{self.port}")
+                sock.close()
+                raise DashboardError(f"dashboard could not serve on {self.host}:{self.port}")
             time.sleep(0.02)
-        if self.port == 0:
-            for srv in server.servers:
-                for sock in srv.sockets:
-                    self.port = int(sock.getsockname()[1])
-                    break
+        if self.bridge._remote_graph is not None:
+            self._graph_thread = threading.Thread(
+                target=self._poll_graph, name="roverlab-dashboard-graph", daemon=True
+            )
+            self._graph_thread.start()
         if self.generated_token:
             print(f"dashboard token (required by every client): {self.token}", file=sys.stderr)
 
+    def _listen(self) -> socket.socket:
+        try:
+            infos = socket.getaddrinfo(self.host, self.port, type=socket.SOCK_STREAM)
+        except OSError as err:
+            raise DashboardError(f"dashboard: bad host {self.host!r}: {err}") from err
+        family, _, _, _, address = infos[0]
+        sock = socket.socket(family, socket.SOCK_STREAM)
+        try:
+            sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+            sock.bind(address)
+            sock.listen(128)
+        except OSError as err:
+            sock.close()
+            raise DashboardError(
+                f"dashboard cannot listen on {self.host}:{self.port}: {err.strerror or err}"
+            ) from err
+        sock.setblocking(False)
+        return sock
+
+    def _poll_graph(self) -> None:
+        while not self._stopping.is_set():
+            with contextlib.suppress(Exception):  # a network hiccup: keep the last graph
+                self.bridge.refresh_remote_graph()
+            self._stopping.wait(_REMOTE_GRAPH_EVERY_S)
+
     def stop(self) -> None:
         """Stop serving and wait for the thread."""
+        self._stopping.set()
         if self._server is not None:
             self._server.should_exit = True
         if self._thread is not None:

@@ -1,0 +1,117 @@
+"""``<node pkg="rviz" type="rviz" args="-d FILE.rviz"/>``: the dashboard started by a launch.
+
+The launch registry maps ``("rviz", "rviz")`` to :func:`start_rviz`. rviz's own command
+line is honoured: ``-d`` / ``--display-config FILE`` (an ``.rviz`` or a saved dashboard
+``.json``) and ``-f`` / ``--fixed-frame FRAME``; other rviz options are reported and
+ignored. The web server binds ``$ROVERLAB_DASHBOARD_HOST`` (default ``127.0.0.1``) and
+``$ROVERLAB_DASHBOARD_PORT`` (default ``8080``; ``0`` picks a free port); it stops when the
+launch's context shuts down.
+"""
+
+from __future__ import annotations
+
+import os
+import shlex
+from collections.abc import Callable
+from pathlib import Path
+from typing import Final
+
+from roverlab.core import Context, Node
+from roverlab.viz.config import ConfigError, DashboardConfig, default_config, load_config
+from roverlab.viz.errors import DashboardError
+from roverlab.viz.server import DashboardServer
+
+__all__ = ["DEFAULT_PORT", "RvizArgs", "parse_rviz_args", "start_rviz"]
+
+DEFAULT_PORT: Final = 8080
+_FLAGS_WITH_VALUE: Final = ("-l", "--log-config", "-s", "--splash-screen", "--opengl")
+
+
+class RvizArgs:
+    """rviz's command line, as far as the dashboard uses it."""
+
+    def __init__(self) -> None:
+        self.display_config: str | None = None
+        self.fixed_frame: str | None = None
+        self.ignored: list[str] = []
+
+
+def parse_rviz_args(args: str) -> RvizArgs:
+    """``-d FILE``, ``--display-config FILE``, ``-f FRAME``, ``--fixed-frame FRAME``.
+
+    Raises:
+        DashboardError: an option without its value.
+    """
+    out = RvizArgs()
+    argv = shlex.split(args)
+    i = 0
+    while i < len(argv):
+        a = argv[i]
+        name, eq, value = a.partition("=")
+        if name in ("-d", "--display-config", "-f", "--fixed-frame"):
+            if not eq:
+                if i + 1 >= len(argv):
+                    raise DashboardError(f"rviz option {a} needs a value")
+                value = argv[i + 1]
+                i += 1
+            if name in ("-d", "--display-config"):
+                out.display_config = value
+            else:
+                out.fixed_frame = value.lstrip("/")
+        elif name in _FLAGS_WITH_VALUE and not eq and i + 1 < len(argv):
+            out.ignored += [a, argv[i + 1]]
+            i += 1
+        else:
+            out.ignored.append(a)
+        i += 1
+    return out
+
+
+def start_rviz(
+    context: Context,
+    args: str,
+    *,
+    node_name: str = "rviz",
+    source: str = "",
+    warn: Callable[[str], None],
+) -> Node | None:
+    """Start the dashboard on ``context`` for an rviz ``<node>``; returns its node.
+
+    A missing or bad display config is reported through ``warn`` and the default
+    displays are used (rviz starts with its defaults too); a port that is taken is
+    reported and the dashboard is not started (None).
+
+    Raises:
+        DashboardError: malformed ``args`` or a bad ``$ROVERLAB_DASHBOARD_PORT``.
+    """
+    where = f"{source}: " if source else ""
+    parsed = parse_rviz_args(args)
+    if parsed.ignored:
+        warn(f"{where}rviz options not used by the dashboard: {' '.join(parsed.ignored)}")
+    config: DashboardConfig | None = None
+    if parsed.display_config is not None:
+        try:
+            config = load_config(Path(parsed.display_config))
+        except ConfigError as err:
+            warn(f"{where}rviz: {err}; using the default displays")
+    if config is None:
+        config = default_config(parsed.fixed_frame or "map")
+    elif parsed.fixed_frame:
+        config.fixed_frame = parsed.fixed_frame
+    host = os.environ.get("ROVERLAB_DASHBOARD_HOST", "127.0.0.1")
+    text = os.environ.get("ROVERLAB_DASHBOARD_PORT", str(DEFAULT_PORT))
+    try:
+        port = int(text)
+    except ValueError:
+        raise DashboardError(
+            f"ROVERLAB_DASHBOARD_PORT must be a port number, got {text!r}"
+        ) from None
+    server = DashboardServer(context, host, port, config=config, node_name=node_name)
+    try:
+        server.start()
+    except DashboardError as err:
+        warn(f"{where}rviz/rviz not started: {err}")
+        server.bridge.node.destroy_node()
+        return None
+    server.bridge.node.get_logger().info(f"rviz: the web dashboard is at {server.url}")
+    return server.bridge.node

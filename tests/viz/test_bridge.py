@@ -1,0 +1,212 @@
+"""VizBridge in one in-process context: subscriptions follow the config, map patches,
+statuses, Save map, compressed images, drive speeds."""
+
+from __future__ import annotations
+
+import io
+import struct
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from roverlab.core import Context, QoSProfile, Time
+from roverlab.geometry import Transform3
+from roverlab.maps import load_map
+from roverlab.msgs import CompressedImage, array_to_occupancy_grid, make, pose_from_xytheta
+from roverlab.tf import StaticTransformBroadcaster
+from roverlab.tf.convert import transform_to_msg
+from roverlab.viz.bridge import VizBridge
+from roverlab.viz.config import DashboardConfig, DisplayConfig
+from roverlab.viz.errors import DashboardError
+from roverlab.viz.protocol import KIND_MAP, KIND_MAP_PATCH, KIND_POSES
+
+LATCHED = QoSProfile(depth=1, durability="transient_local")
+
+
+def _config(*displays: DisplayConfig, frame: str = "map") -> DashboardConfig:
+    return DashboardConfig(fixed_frame=frame, displays=list(displays))
+
+
+def _rows(bridge: VizBridge, slot: int) -> dict[str, tuple[str, str]]:
+    status = bridge.status({}, [])
+    return {name: (level, text) for level, name, text in status["displays"][slot]}
+
+
+def test_map_updates_travel_as_patches_and_save_map(tmp_path: Path) -> None:
+    ctx = Context()
+    node = ctx.create_node("pub")
+    pub = node.create_publisher("nav_msgs/msg/OccupancyGrid", "/map", LATCHED)
+    bridge = VizBridge(
+        context=ctx, config=_config(DisplayConfig("map", "Map", True, "/map")), map_dir=tmp_path
+    )
+    cells = np.zeros((60, 80), dtype=np.int8)
+    cells[:, :10] = -1
+    pub.publish(array_to_occupancy_grid(cells, resolution=0.1, origin=(-1.0, -2.0, 0.0)))
+    ctx.spin_for(0.1)
+    (d,) = bridge.displays
+    assert d.map_base is not None and d.map_base.payload[0] == KIND_MAP
+    assert struct.unpack_from("<II", d.map_base.payload, 4) == (80, 60)
+    cells2 = cells.copy()
+    cells2[30:33, 40:45] = 100
+    pub.publish(array_to_occupancy_grid(cells2, resolution=0.1, origin=(-1.0, -2.0, 0.0)))
+    ctx.spin_for(0.1)
+    assert len(d.map_patches) == 1 and d.frame is d.map_patches[0]
+    patch = d.map_patches[0].payload
+    assert patch[0] == KIND_MAP_PATCH
+    assert struct.unpack_from("<IIII", patch, 4) == (40, 30, 5, 3)
+    assert len(patch) == 20 + 15  # only the changed window travels
+    # the same map again changes nothing; a new origin sends a full map
+    pub.publish(array_to_occupancy_grid(cells2, resolution=0.1, origin=(-1.0, -2.0, 0.0)))
+    ctx.spin_for(0.1)
+    assert len(d.map_patches) == 1
+    pub.publish(array_to_occupancy_grid(cells2, resolution=0.1, origin=(0.0, 0.0, 0.0)))
+    ctx.spin_for(0.1)
+    assert d.map_patches == [] and d.frame is d.map_base
+    yaml_path = bridge.save_map("saved")
+    assert yaml_path == tmp_path / "saved.yaml"
+    loaded = load_map(yaml_path)
+    assert loaded.data.shape == (60, 80) and (loaded.data[30:33, 40:45] == 100).all()
+    with pytest.raises(DashboardError, match="bad map name"):
+        bridge.save_map("../evil")
+    ctx.shutdown()
+
+
+def test_statuses_no_publisher_no_messages_tf_failure_and_ok() -> None:
+    ctx = Context()
+    node = ctx.create_node("pub")
+    StaticTransformBroadcaster(node).send_transform(
+        transform_to_msg("map", "odom", Time(0), Transform3((1.0, 0.0, 0.0)))
+    )
+    good = node.create_publisher("geometry_msgs/msg/PoseArray", "/good", 1)
+    lost = node.create_publisher("geometry_msgs/msg/PoseArray", "/lost", 1)
+    node.create_publisher("geometry_msgs/msg/PoseArray", "/quiet", 1)
+    bridge = VizBridge(
+        context=ctx,
+        config=_config(
+            DisplayConfig("pose_array", "good", True, "/good"),
+            DisplayConfig("pose_array", "lost", True, "/lost"),
+            DisplayConfig("pose_array", "quiet", True, "/quiet"),
+            DisplayConfig("pose_array", "nobody", True, "/nobody"),
+            DisplayConfig("odometry", "wrong type", True, "/good"),
+            DisplayConfig("pose_array", "off", False, "/good"),
+        ),
+    )
+    ctx.spin_for(0.1)
+    good.publish(make("geometry_msgs/msg/PoseArray", header={"frame_id": "odom"},
+                      poses=[pose_from_xytheta(1.0, 2.0, 0.0)]))  # fmt: skip
+    lost.publish(make("geometry_msgs/msg/PoseArray", header={"frame_id": "ghost"},
+                      poses=[pose_from_xytheta(0.0, 0.0, 0.0)]))  # fmt: skip
+    ctx.spin_for(0.1)
+    assert _rows(bridge, 0)["Topic"][0] == "ok" and _rows(bridge, 0)["Transform"][0] == "ok"
+    frame = bridge.displays[0].frame
+    assert frame is not None and frame.payload[0] == KIND_POSES
+    xyyaw = np.frombuffer(frame.payload[8:], dtype="<f4")
+    assert np.allclose(xyyaw, [2.0, 2.0, 0.0])  # odom is 1 m along map's x
+    level, text = _rows(bridge, 1)["Transform"]
+    assert level == "error" and "ghost" in text
+    assert _rows(bridge, 2)["Topic"] == ("warn", "No messages received on /quiet")
+    assert _rows(bridge, 3)["Topic"] == ("warn", "No publisher on /nobody")
+    assert _rows(bridge, 4)["Topic"][0] == "error"  # /good carries PoseArray, not Odometry
+    assert _rows(bridge, 5) == {"Status": ("disabled", "disabled")}
+    glob = bridge.status({}, [])["global"]
+    assert glob[0][:2] == ["ok", "Fixed Frame"]
+    ctx.shutdown()
+
+
+def test_config_changes_move_subscriptions() -> None:
+    ctx = Context()
+    bridge = VizBridge(context=ctx, config=_config(DisplayConfig("laser_scan", "s", True, "/scan")))
+    assert "/scan" in ctx.graph.topics
+    first = bridge.displays[0]
+    bridge.set_config(
+        _config(
+            DisplayConfig("path", "p", True, "/plan"),
+            DisplayConfig("laser_scan", "s", True, "/scan", {"decay_s": 1.0}),
+        )
+    )
+    ctx.spin_for(0.05)
+    assert bridge.displays[1] is first and first.slot == 1  # kept, with its data
+    assert first.config.option("decay_s") == 1.0
+    bridge.set_config(_config(DisplayConfig("laser_scan", "s", True, "/scan2")))
+    ctx.spin_for(0.05)
+    assert "/scan" not in ctx.graph.topics and "/plan" not in ctx.graph.topics
+    assert bridge.displays[0] is not first and "/scan2" in ctx.graph.topics
+    ctx.shutdown()
+
+
+def test_compressed_and_depth_images() -> None:
+    ctx = Context()
+    node = ctx.create_node("cam")
+    pub = node.create_publisher("sensor_msgs/msg/CompressedImage", "/cam/compressed", 1)
+    bridge = VizBridge(
+        context=ctx, config=_config(DisplayConfig("image", "cam", True, "/cam/compressed"))
+    )
+    assert bridge.displays[0].sub_key[1] == "sensor_msgs/msg/CompressedImage"
+    buf = io.BytesIO()
+    Image.fromarray(np.full((8, 8, 3), 200, dtype=np.uint8)).save(buf, format="JPEG")
+    pub.publish(CompressedImage(format="jpeg", data=np.frombuffer(buf.getvalue(), np.uint8)))
+    ctx.spin_for(0.05)
+    assert bridge.image_topics() == ["/cam/compressed"]
+    frame = bridge.image_frame(bridge.displays[0])
+    assert frame is not None and frame.payload[4:] == buf.getvalue()  # passed through
+    # compressedDepth: a 12-byte header, then a 16-bit PNG; shown through the colour map
+    depth = np.tile(np.linspace(1000, 3000, 64).astype(np.uint16), (16, 1))
+    depth[:, :8] = 0
+    png = io.BytesIO()
+    Image.fromarray(depth).save(png, format="PNG")
+    data = np.frombuffer(b"\0" * 12 + png.getvalue(), np.uint8)
+    pub.publish(CompressedImage(format="16UC1; compressedDepth", data=data))
+    ctx.spin_for(0.05)
+    frame = bridge.image_frame(bridge.displays[0])
+    assert frame is not None
+    rgb = np.asarray(Image.open(io.BytesIO(frame.payload[4:])).convert("RGB")).astype(int)
+    assert rgb.shape == (16, 64, 3) and rgb[8, 2].max() < 40  # no data: black
+    assert rgb[8, 12, 2] > 100 and rgb[8, 60, 0] > 100  # near blue, far red
+    pub.publish(CompressedImage(format="bmp", data=np.frombuffer(b"BM....", np.uint8)))
+    ctx.spin_for(0.05)
+    assert bridge.image_frame(bridge.displays[0]) is None
+    assert "neither JPEG nor PNG" in (bridge.displays[0].error or "")
+    ctx.shutdown()
+
+
+def test_drive_speed_keys_and_limits() -> None:
+    ctx = Context()
+    node = ctx.create_node("robot")
+    got: list[object] = []
+    node.create_subscription("geometry_msgs/msg/Twist", "/cmd_vel", got.append, 10)
+    bridge = VizBridge(context=ctx, config=_config())
+    assert bridge.drive_key("q")  # speeds up by 10 %, like teleop_twist_keyboard
+    assert bridge.speed_mps == pytest.approx(0.33) and bridge.turn_radps == pytest.approx(0.55)
+    bridge.drive_key("i")
+    ctx.spin_for(0.05)
+    assert got and got[-1].linear.x == pytest.approx(0.33)  # type: ignore[attr-defined]
+    bridge.set_speeds(1.0, 2.0)
+    with pytest.raises(DashboardError, match="speed"):
+        bridge.set_speeds(-1.0, 1.0)
+    ctx.shutdown()
+
+
+def test_marker_lifetime_expires_on_the_executor_clock() -> None:
+    ctx = Context()
+    node = ctx.create_node("m")
+    pub = node.create_publisher("visualization_msgs/msg/Marker", "/m", 10)
+    bridge = VizBridge(context=ctx, config=_config(DisplayConfig("marker", "m", True, "/m")))
+    pub.publish(
+        make(
+            "visualization_msgs/msg/Marker",
+            header={"frame_id": "map"},
+            type=1,
+            scale={"x": 1.0, "y": 1.0, "z": 1.0},
+            color={"r": 1.0, "a": 1.0},
+            lifetime={"sec": 1, "nanosec": 0},
+        )
+    )
+    ctx.spin_for(0.5)
+    frame = bridge.displays[0].frame
+    assert frame is not None and '"polygon"' in frame.payload
+    ctx.spin_for(1.0)
+    frame = bridge.displays[0].frame
+    assert frame is not None and frame.payload == "[]"
+    ctx.shutdown()

@@ -1,0 +1,172 @@
+"""Display configurations: the seeds' .rviz files, the dashboard's JSON, bad input."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from roverlab.viz.config import (
+    CONFIG_FORMAT,
+    DISPLAY_KINDS,
+    ConfigError,
+    DashboardConfig,
+    DisplayConfig,
+    config_from_dict,
+    default_config,
+    load_config,
+    load_rviz,
+    parse_rviz,
+    save_config,
+)
+
+FIXTURES = Path(__file__).parent / "fixtures"
+
+
+def test_gmapping_rviz_from_seed_000_loads() -> None:
+    config = load_rviz(FIXTURES / "gmapping.rviz")
+    assert config.fixed_frame == "map"
+    assert [d.kind for d in config.displays] == [
+        "grid",
+        "odometry",
+        "odometry",
+        "robot_model",
+        "map",
+        "laser_scan",
+    ]
+    assert config.unsupported == []
+    grid, odom, ekf, robot, gmap, scan = config.displays
+    assert grid.option("cell_size") == 0.5 and grid.option("cell_count") == 80
+    assert grid.option("color") == [88, 88, 90] and grid.option("reference_frame") == "map"
+    assert not odom.enabled and odom.topic == "/odom" and odom.option("keep") == 100
+    assert odom.option("color") == [255, 25, 0]  # from Shape/Color
+    assert odom.option("length") == pytest.approx(1.3)  # Shaft Length + Head Length
+    assert ekf.name == "Odometry EKF"
+    assert robot.enabled and robot.topic == "/robot_description"
+    assert gmap.topic == "/map" and gmap.option("alpha") == 0.5
+    assert gmap.option("color_scheme") == "map" and gmap.option("draw_behind") is True
+    assert scan.topic == "/scan" and scan.option("color") == [255, 0, 0]
+    assert scan.option("decay_s") == 0.0 and scan.option("size_px") == 3.0
+
+
+def test_test_rviz_from_seed_001_loads() -> None:
+    config = load_rviz(FIXTURES / "test.rviz")
+    assert config.fixed_frame == "odom"
+    kinds = {d.kind: d for d in config.displays}
+    assert list(kinds) == ["grid", "robot_model", "tf", "odometry"]
+    assert kinds["grid"].option("reference_frame") == ""  # <Fixed Frame>
+    assert not kinds["tf"].enabled and kinds["tf"].option("show_names") is True
+    assert kinds["odometry"].option("keep") == 10
+    assert kinds["odometry"].option("position_tolerance") == pytest.approx(0.1)
+
+
+def test_unknown_display_classes_are_listed_not_errors() -> None:
+    text = """
+Visualization Manager:
+  Displays:
+    - Class: rviz/Axes
+      Name: Axes
+    - Class: rviz/Group
+      Name: Nav
+      Displays:
+        - Class: rviz/Path
+          Name: Plan
+          Topic: /plan
+          Color: 0; 0; 255
+          Line Width: 0.05
+        - Class: rviz_default_plugins/Map
+          Name: Costmap
+          Topic: /costmap
+          Color Scheme: costmap
+    - Class: rviz/Image
+      Name: Cam
+      Topic: /camera/image_raw
+      Transport Hint: compressed
+  Global Options:
+    Fixed Frame: /odom
+"""
+    config = parse_rviz(text, "nav.rviz")
+    assert config.unsupported == ["Axes (rviz/Axes)"]
+    assert config.fixed_frame == "odom"
+    plan, costmap, cam = config.displays
+    assert plan.kind == "path" and plan.option("color") == [0, 0, 255]
+    assert plan.option("line_width") == 0.05
+    assert costmap.kind == "map" and costmap.option("color_scheme") == "costmap"
+    assert cam.kind == "image" and cam.topic == "/camera/image_raw/compressed"
+
+
+@pytest.mark.parametrize(
+    ("text", "needle"),
+    [
+        ("a: [", "not a valid .rviz"),
+        ("Panels: []", "no 'Visualization Manager'"),
+        ("Visualization Manager:\n  Displays: 3", "'Displays' must be a list"),
+        (
+            "Visualization Manager:\n  Displays:\n    - Class: rviz/Map\n      Alpha: lots",
+            "Alpha must be a number",
+        ),
+        (
+            "Visualization Manager:\n  Displays:\n    - Class: rviz/LaserScan\n      Color: red",
+            "bad colour",
+        ),
+    ],
+)
+def test_bad_rviz_files_give_one_clear_error(text: str, needle: str) -> None:
+    with pytest.raises(ConfigError, match=needle) as info:
+        parse_rviz(text, "bad.rviz")
+    assert "bad.rviz" in str(info.value)
+
+
+def test_dashboard_json_round_trips(tmp_path: Path) -> None:
+    config = load_rviz(FIXTURES / "gmapping.rviz")
+    config.displays.append(DisplayConfig("marker", "M", True, "/m", {}))
+    path = save_config(config, tmp_path / "sub" / "dash.json")
+    data = json.loads(path.read_text())
+    assert data["format"] == CONFIG_FORMAT and data["version"] == 1
+    # every option is written, defaults included
+    assert set(data["displays"][5]["options"]) == set(DISPLAY_KINDS["laser_scan"].options)
+    back = load_config(path)
+    assert back.fixed_frame == config.fixed_frame
+    assert [d.to_dict() for d in back.displays] == [d.to_dict() for d in config.displays]
+    assert not list(tmp_path.glob("sub/.dash.json.*")), "temp file left behind"
+
+
+def test_load_config_reads_rviz_files_too() -> None:
+    assert load_config(FIXTURES / "test.rviz").fixed_frame == "odom"
+
+
+@pytest.mark.parametrize(
+    ("mutate", "needle"),
+    [
+        (lambda d: d.update(format="x"), "not a roverlab dashboard config"),
+        (lambda d: d.update(version=9), "unsupported config version"),
+        (lambda d: d["displays"][0].update(kind="teapot"), "unknown display kind"),
+        (lambda d: d["displays"][1]["options"].update(alhpa=1), "no option 'alhpa'"),
+        (lambda d: d["displays"][1]["options"].update(alpha="x"), "must be a number"),
+        (lambda d: d["displays"][1]["options"].update(color_scheme="neon"), "must be one of"),
+        (lambda d: d["displays"][0].update(colour=1), "unknown display key"),
+    ],
+)
+def test_bad_json_configs_are_rejected(mutate: object, needle: str) -> None:
+    data = default_config().to_dict()
+    mutate(data)  # type: ignore[operator]
+    with pytest.raises(ConfigError, match=needle):
+        config_from_dict(data, "page")
+
+
+def test_default_config_has_every_kind_and_validates() -> None:
+    config = default_config("odom")
+    assert config.fixed_frame == "odom"
+    assert {d.kind for d in config.displays} == set(DISPLAY_KINDS)
+    again = config_from_dict(config.to_dict())
+    assert isinstance(again, DashboardConfig) and len(again.displays) == len(config.displays)
+
+
+def test_unreadable_file_is_a_config_error(tmp_path: Path) -> None:
+    with pytest.raises(ConfigError, match="cannot read"):
+        load_config(tmp_path / "missing.rviz")
+    bad = tmp_path / "bad.json"
+    bad.write_text("{ nope")
+    with pytest.raises(ConfigError, match="not valid JSON"):
+        load_config(bad)
