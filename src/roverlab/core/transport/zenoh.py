@@ -235,17 +235,18 @@ class ZenohTransport:
         with self._lock:
             link = self._link(topic.name)
             if added:
-                link.tokens[pub] = self.session.liveliness().declare_token(
-                    self._g("p", pub.node.get_fully_qualified_name(), topic.name, topic.typename)
-                    + ("/latched" if pub.qos.latched else "/volatile")
-                )
                 if link.publisher is None:
                     self._declare_publisher(topic, link)
+                # the history's queryable before the token that makes others ask for it
                 if pub.qos.latched and link.latched_queryable is None:
                     key = f"rl/{self.domain}/l/{topic.name.lstrip('/')}/{self.zid}"
                     link.latched_queryable = self.session.declare_queryable(
                         key, partial(self._on_latched_query, topic)
                     )
+                link.tokens[pub] = self.session.liveliness().declare_token(
+                    self._g("p", pub.node.get_fully_qualified_name(), topic.name, topic.typename)
+                    + ("/latched" if pub.qos.latched else "/volatile")
+                )
             else:
                 tok = link.tokens.pop(pub, None)
                 if tok is not None:
