@@ -16,9 +16,10 @@ from roverlab.core import Context, Node, QoSProfile, Time
 from roverlab.geometry import SE2, Transform3
 from roverlab.launch import LaunchError, build_launch
 from roverlab.mapping.gmapping import GMappingParams
-from roverlab.mapping.gmapping.node import SlamGMapping, laser_geometry
+from roverlab.mapping.gmapping.node import SlamGMapping
 from roverlab.mapping.hector import HectorParams
 from roverlab.mapping.hector.node import NODE_DEFAULTS, HectorMapping
+from roverlab.mapping.laser import laser_geometry
 from roverlab.msgs import String, Twist, make_scan, xytheta_from_pose
 from roverlab.msgs import classes as mc
 from roverlab.raycast import Scene, cast_2d

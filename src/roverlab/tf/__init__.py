@@ -34,6 +34,7 @@ from roverlab.tf.errors import (
     TimeoutException,
     TransformException,
 )
+from roverlab.tf.message_filter import TfMessageFilter, Throttle
 from roverlab.tf.ros import (
     TF_STATIC_TOPIC,
     TF_TOPIC,
@@ -62,6 +63,8 @@ __all__ = [
     "NoDataForExtrapolationException",
     "NodeLike",
     "StaticTransformBroadcaster",
+    "TfMessageFilter",
+    "Throttle",
     "TimeoutException",
     "TransformBroadcaster",
     "TransformException",

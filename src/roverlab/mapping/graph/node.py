@@ -30,14 +30,16 @@ import numpy as np
 
 from roverlab.core import Context, Node, QoSProfile, Time
 from roverlab.geometry import Transform3
-from roverlab.mapping.gmapping.node import TfMessageFilter, Throttle, laser_geometry
 from roverlab.mapping.graph.errors import GraphSlamInputError
 from roverlab.mapping.graph.params import GraphParams
 from roverlab.mapping.graph.slam import GraphSLAM
+from roverlab.mapping.laser import laser_geometry
 from roverlab.msgs import MapMetaData, OccupancyGrid, array_to_occupancy_grid
 from roverlab.msgs import classes as mc
 from roverlab.tf import (
     Buffer,
+    TfMessageFilter,
+    Throttle,
     TransformBroadcaster,
     TransformException,
     TransformListener,

@@ -42,10 +42,10 @@ import numpy as np
 
 from roverlab.core import Context, Node, QoSProfile, Time
 from roverlab.geometry import SE2, Transform3
-from roverlab.mapping.gmapping.node import TfMessageFilter, Throttle, laser_geometry
 from roverlab.mapping.hector.errors import HectorInputError, OutOfMapError
 from roverlab.mapping.hector.params import HectorParams
 from roverlab.mapping.hector.slam import HectorSLAM
+from roverlab.mapping.laser import laser_geometry
 from roverlab.msgs import (
     MapMetaData,
     OccupancyGrid,
@@ -58,6 +58,8 @@ from roverlab.msgs import (
 from roverlab.msgs import classes as mc
 from roverlab.tf import (
     Buffer,
+    TfMessageFilter,
+    Throttle,
     TransformBroadcaster,
     TransformException,
     TransformListener,

@@ -1,0 +1,178 @@
+"""tf2_ros' MessageFilter for roverlab's single-threaded executor, and a log throttle.
+
+:class:`TfMessageFilter` holds stamped messages until their frame can be transformed into
+the target frames at their stamp, retrying whenever ``/tf`` or ``/tf_static`` brings data
+(it never blocks the executor); :class:`Throttle` repeats a warning at most once per
+period of the node's clock (``ROS_WARN_THROTTLE``).
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from collections.abc import Callable
+from typing import Any
+
+from roverlab.core import Node, QoSProfile, Time
+from roverlab.tf.buffer import Buffer
+from roverlab.tf.convert import TF_MESSAGE_TYPE
+from roverlab.tf.errors import BackwardExtrapolationException, TransformException
+from roverlab.tf.ros import TF_STATIC_TOPIC, TF_TOPIC
+
+__all__ = ["TfMessageFilter", "Throttle"]
+
+# seconds between two repetitions of the same warning (ROS_WARN_THROTTLE-like)
+_WARN_PERIOD_S = 10.0
+
+
+class Throttle:
+    """Lets a message through at most once per ``period_s`` of the node's clock.
+
+    Args:
+        node: whose clock and logger are used.
+        period_s: seconds between two messages of the same key.
+    """
+
+    def __init__(self, node: Node, period_s: float = _WARN_PERIOD_S) -> None:
+        self._node = node
+        self._period_ns = round(period_s * 1e9)
+        self._last: dict[str, int] = {}
+
+    def warning(self, key: str, text: str) -> bool:
+        """Log ``text`` as a warning unless ``key`` was logged less than a period ago."""
+        now = self._node.get_clock().now_ns()
+        last = self._last.get(key)
+        if last is not None and now - last < self._period_ns:
+            return False
+        self._last[key] = now
+        self._node.get_logger().warning(text)
+        return True
+
+
+class TfMessageFilter:
+    """Holds stamped messages until ``target_frame <- msg.header.frame_id`` is in the buffer
+    at the message's stamp, then hands them to ``callback`` in arrival order (tf2_ros
+    MessageFilter, for an executor that must not block).
+
+    Waiting messages are retried whenever ``/tf`` or ``/tf_static`` brings data. A message is
+    dropped when ``queue_size`` newer ones wait behind it, when its stamp is older than the
+    buffer's data (it can never be transformed), or, with ``timeout_s``, when it has waited
+    that long on the node's clock; drops are counted and reported by a throttled warning.
+    ``optional_frames`` are waited for too, but only up to ``timeout_s``: then the message
+    is handed on without them (hector's ``waitForTransform`` before a lookup that may fail).
+
+    Args:
+        node: the node that subscribes ``/tf`` and ``/tf_static`` for the retries.
+        buffer: the TF buffer (fed by a :class:`~roverlab.tf.TransformListener` created
+            before this filter, so that a retry sees the data that triggered it).
+        target_frames: frames every message must be transformable into.
+        queue_size: how many messages may wait.
+        callback: called with each message once it can be transformed.
+        timeout_s: drop a message that waited this long (None: never).
+        optional_frames: frames waited for at most ``timeout_s``.
+        on_timeout: called with each message dropped for waiting ``timeout_s`` (instead of
+            the throttled warning; it is still counted).
+
+    Attributes:
+        dropped: messages dropped so far.
+        passed: messages handed on so far.
+    """
+
+    def __init__(
+        self,
+        node: Node,
+        buffer: Buffer,
+        target_frames: list[str],
+        queue_size: int,
+        callback: Callable[[Any], Any],
+        *,
+        timeout_s: float | None = None,
+        optional_frames: list[str] | None = None,
+        on_timeout: Callable[[Any], Any] | None = None,
+    ) -> None:
+        if queue_size < 1:
+            raise ValueError(f"queue_size must be >= 1, got {queue_size}")
+        self._node = node
+        self._buffer = buffer
+        self.target_frames = list(target_frames)
+        self.optional_frames = list(optional_frames or [])
+        self._callback = callback
+        self._on_timeout = on_timeout
+        self._timeout_ns = None if timeout_s is None else round(timeout_s * 1e9)
+        self._queue: deque[tuple[Any, int]] = deque()
+        self._queue_size = queue_size
+        self._throttle = Throttle(node)
+        self.dropped = 0
+        self.passed = 0
+        node.create_subscription(TF_MESSAGE_TYPE, TF_TOPIC, self._on_tf, 100)
+        node.create_subscription(
+            TF_MESSAGE_TYPE,
+            TF_STATIC_TOPIC,
+            self._on_tf,
+            QoSProfile(depth=100, durability="transient_local"),
+        )
+
+    @property
+    def waiting(self) -> int:
+        """Messages waiting for their transform."""
+        return len(self._queue)
+
+    def add(self, msg: Any) -> None:
+        """Queue ``msg`` and hand on every message that can now be transformed."""
+        self._queue.append((msg, self._node.get_clock().now_ns()))
+        self._drain()
+        while len(self._queue) > self._queue_size:
+            old, _ = self._queue.popleft()
+            self._drop(old, "discarding message because the queue is full")
+
+    def _on_tf(self, _msg: Any) -> None:
+        if self._queue:
+            self._drain()
+
+    def _drain(self) -> None:
+        now = self._node.get_clock().now_ns()
+        while self._queue:
+            msg, arrived = self._queue[0]
+            expired = self._timeout_ns is not None and now - arrived >= self._timeout_ns
+            state = self._ready(msg, self.target_frames)
+            if state == "ready" and not expired:
+                state = self._ready(msg, self.optional_frames)
+            if state == "ready":
+                self._queue.popleft()
+                self.passed += 1
+                self._callback(msg)
+                continue
+            if state == "too_old":
+                self._queue.popleft()
+                self._drop(msg, "the transform is older than the TF buffer's data")
+                continue
+            if expired:
+                self._queue.popleft()
+                if self._on_timeout is None:
+                    self._drop(msg, "timed out waiting for the transform")
+                else:
+                    self.dropped += 1
+                    self._on_timeout(msg)
+                continue
+            return
+
+    def _ready(self, msg: Any, targets: list[str]) -> str:
+        frame = str(msg.header.frame_id).lstrip("/")
+        stamp = Time.from_msg(msg.header.stamp)
+        for target in targets:
+            try:
+                self._buffer.lookup_transform(target, frame, stamp)
+            except BackwardExtrapolationException:
+                return "too_old"
+            except TransformException:
+                return "wait"
+        return "ready"
+
+    def _drop(self, msg: Any, reason: str) -> None:
+        self.dropped += 1
+        total = self.dropped + self.passed
+        targets = ", ".join(self.target_frames)
+        self._throttle.warning(
+            "drop",
+            f"MessageFilter [target={targets}]: dropped {100.0 * self.dropped / total:.2f}% of "
+            f"messages so far (frame {str(msg.header.frame_id)!r}: {reason})",
+        )
