@@ -43,12 +43,13 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import NamedTuple, Protocol
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from roverlab.geometry import SE2
+from roverlab.mapping.common import ScanLike
 from roverlab.mapping.gmapping import kernels
 from roverlab.mapping.gmapping.errors import GMappingInputError
 from roverlab.mapping.gmapping.grid import GMappingMap, ParticleMaps
@@ -89,27 +90,6 @@ _RECOVER_MARGIN = 0.15
 # the one nearest the odometry wins (a radian of heading counts as this many metres).
 _RECOVER_TIE = 0.03
 _RECOVER_RAD_TO_M = 1.0
-
-
-class ScanLike(Protocol):
-    """What :meth:`GMapping.run_log` reads from a log record (``roverlab.slam.logs``)."""
-
-    @property
-    def timestamp(self) -> float: ...
-    @property
-    def ranges(self) -> NDArray[np.float32]: ...
-    @property
-    def angle_min(self) -> float: ...
-    @property
-    def angle_increment(self) -> float: ...
-    @property
-    def range_min(self) -> float: ...
-    @property
-    def range_max(self) -> float: ...
-    @property
-    def odom_pose(self) -> SE2 | tuple[float, float, float]: ...
-    @property
-    def laser_offset(self) -> SE2: ...
 
 
 @dataclass(frozen=True, slots=True)

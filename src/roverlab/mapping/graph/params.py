@@ -20,6 +20,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from roverlab.mapping.common import params_from_ros
 from roverlab.mapping.graph.errors import GraphSlamParamsError
 
 __all__ = ["NODE_PARAMETERS", "GraphParams"]
@@ -267,21 +268,14 @@ class GraphParams:
         Raises:
             GraphSlamParamsError: an unknown name or a bad value.
         """
-        names = {f.name: f.type for f in dataclasses.fields(cls)}
-        kwargs: dict[str, Any] = {}
-        for key, value in params.items():
-            if key in NODE_PARAMETERS:
-                continue
-            if key not in names:
-                raise GraphSlamParamsError(f"unknown slam_toolbox/slam_karto parameter {key!r}")
-            if (
-                names[key] in ("float", float)
-                and isinstance(value, int)
-                and not isinstance(value, bool)
-            ):
-                value = float(value)
-            kwargs[key] = value
-        return cls(**kwargs)
+        return params_from_ros(
+            cls,
+            params,
+            ignored=NODE_PARAMETERS,
+            unknown=lambda name: GraphSlamParamsError(
+                f"unknown slam_toolbox/slam_karto parameter {name!r}"
+            ),
+        )
 
 
 def _check(ok: bool, msg: str) -> None:

@@ -47,7 +47,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
-from typing import Any, NamedTuple, Protocol
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -55,6 +55,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import breadth_first_order
 
 from roverlab.geometry import SE2
+from roverlab.mapping.common import ScanLike
 from roverlab.mapping.graph.errors import GraphSlamInputError
 from roverlab.mapping.graph.matcher import (
     CorrelationGrid,
@@ -80,29 +81,6 @@ OCCUPANCY_THRESHOLD = 0.1
 #: Largest number of solver iterations after a loop closure (warm-started).
 _OPT_ITERATIONS = 20
 _TWO_PI = 2.0 * math.pi
-
-
-class ScanLike(Protocol):
-    """What :meth:`GraphSLAM.run_log` reads from a scan (a ``roverlab.slam.ScanRecord``)."""
-
-    @property
-    def timestamp(self) -> float: ...
-    @property
-    def timestamp_text(self) -> str: ...
-    @property
-    def ranges(self) -> NDArray[np.float32]: ...
-    @property
-    def angle_min(self) -> float: ...
-    @property
-    def angle_increment(self) -> float: ...
-    @property
-    def range_min(self) -> float: ...
-    @property
-    def range_max(self) -> float: ...
-    @property
-    def odom_pose(self) -> SE2: ...
-    @property
-    def laser_offset(self) -> SE2: ...
 
 
 @dataclass(frozen=True, eq=False)

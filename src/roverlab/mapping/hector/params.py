@@ -14,6 +14,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from roverlab.mapping.common import params_from_ros
 from roverlab.mapping.hector.errors import HectorParamsError
 
 __all__ = ["MOTION_PREDICTIONS", "NODE_PARAMETERS", "HectorParams"]
@@ -179,21 +180,12 @@ class HectorParams:
         Raises:
             HectorParamsError: an unknown name or a bad value.
         """
-        names = {f.name: f.type for f in dataclasses.fields(cls)}
-        kwargs: dict[str, Any] = {}
-        for key, value in params.items():
-            if key in NODE_PARAMETERS:
-                continue
-            if key not in names:
-                raise HectorParamsError(f"unknown hector_mapping parameter {key!r}")
-            if (
-                names[key] in ("float", float)
-                and isinstance(value, int)
-                and not isinstance(value, bool)
-            ):
-                value = float(value)
-            kwargs[key] = value
-        return cls(**kwargs)
+        return params_from_ros(
+            cls,
+            params,
+            ignored=NODE_PARAMETERS,
+            unknown=lambda name: HectorParamsError(f"unknown hector_mapping parameter {name!r}"),
+        )
 
     def level_resolution(self, level: int) -> float:
         """Cell size (m) of map level ``level`` (0 is the finest)."""

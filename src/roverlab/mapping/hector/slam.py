@@ -21,12 +21,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable
-from typing import NamedTuple, Protocol
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from roverlab.geometry import SE2, wrap_angle
+from roverlab.mapping.common import ScanLike
 from roverlab.mapping.hector.errors import HectorInputError, OutOfMapError
 from roverlab.mapping.hector.grid import HectorMap, MultiResGrid
 from roverlab.mapping.hector.matcher import match
@@ -36,29 +37,6 @@ from roverlab.slam.trajectory import Trajectory
 __all__ = ["HectorRun", "HectorSLAM", "ScanLike", "run_log"]
 
 _IDENTITY = SE2()
-
-
-class ScanLike(Protocol):
-    """What :meth:`HectorSLAM.run_log` reads from a scan (a ``roverlab.slam.ScanRecord``)."""
-
-    @property
-    def timestamp(self) -> float: ...
-    @property
-    def timestamp_text(self) -> str: ...
-    @property
-    def ranges(self) -> NDArray[np.float32]: ...
-    @property
-    def angle_min(self) -> float: ...
-    @property
-    def angle_increment(self) -> float: ...
-    @property
-    def range_min(self) -> float: ...
-    @property
-    def range_max(self) -> float: ...
-    @property
-    def odom_pose(self) -> SE2: ...
-    @property
-    def laser_offset(self) -> SE2: ...
 
 
 class HectorRun(NamedTuple):
