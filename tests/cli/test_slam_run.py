@@ -125,3 +125,36 @@ def test_graph_parameter_errors_come_before_reading_the_log(tmp_path: Path) -> N
     )  # fmt: skip
     assert r.returncode == 2
     assert "no_such_thing" in r.stderr and len(r.stderr.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("method", ["hector", "gmapping", "graph"])
+def test_a_simulator_recording_maps_the_maze(tmp_path: Path, method: str) -> None:
+    """A recording of ``roverlab sim`` (odometry from TF) -> ``slam run`` -> ``slam mapeval``."""
+    from roverlab.bag import McapRecorder
+    from roverlab.core import Context
+    from roverlab.msgs import Twist
+    from roverlab.sim.app import Simulation
+
+    rec = tmp_path / "sim.mcap"
+    context = Context(clock="sim")
+    context.add_transport(McapRecorder(rec))
+    Simulation(context=context, world="maze", robot="mybot", cameras=False)
+    driver = context.create_node("driver")
+    pub = driver.create_publisher(Twist, "/cmd_vel", 10)
+    driver.create_timer(0.1, lambda: pub.publish(Twist(linear_x=0.05, angular_z=0.6)))
+    context.spin_for(15.0)
+    context.shutdown()
+
+    out = tmp_path / method
+    cli = [sys.executable, "-m", "roverlab.cli", "slam"]
+    r = subprocess.run(
+        [*cli, "run", str(rec), "--method", method, "--odom-topic", "", "--out", str(out)],
+        capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert r.returncode == 0, r.stderr
+    assert len((out / "trajectory.tum").read_text().splitlines()) >= 100  # 7 Hz x 15 s
+    e = subprocess.run(
+        [*cli, "mapeval", str(out / "map.yaml"), "--world", "maze", "--min-accuracy", "0.95"],
+        capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert e.returncode == 0, e.stdout + e.stderr

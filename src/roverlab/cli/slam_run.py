@@ -190,8 +190,25 @@ def run(
         str, typer.Option("--scan-topic", help="Bags: the LaserScan topic.")
     ] = "/scan",
     odom_topic: Annotated[
-        str, typer.Option("--odom-topic", help="Bags: the Odometry topic.")
+        str,
+        typer.Option(
+            "--odom-topic",
+            help="Bags: the Odometry topic; '' takes odometry from TF (odom frame -> base "
+            "frame on --tf-topic).",
+        ),
     ] = "/odom",
+    tf_topic: Annotated[str, typer.Option("--tf-topic", help="Bags: the TF topic.")] = "/tf",
+    odom_frame: Annotated[
+        str, typer.Option("--odom-frame", help="Bags: the odometry frame (TF odometry).")
+    ] = "odom",
+    base_frame: Annotated[
+        str | None,
+        typer.Option(
+            "--base-frame",
+            help="Bags: the robot frame (default: the Odometry messages' child frame, or "
+            "the TF child of the odometry frame).",
+        ),
+    ] = None,
     first: Annotated[
         int | None, typer.Option("--first", help="Use only the first N scans of the log.")
     ] = None,
@@ -223,7 +240,14 @@ def run(
     if log.suffix in (".clf", ".gz", ".bz2"):
         records = load_log(log)
     else:
-        records = load_log(log, scan_topic=scan_topic, odom_topic=odom_topic)
+        records = load_log(
+            log,
+            scan_topic=scan_topic,
+            odom_topic=odom_topic or None,
+            tf_topic=tf_topic,
+            odom_frame=odom_frame,
+            base_frame=base_frame,
+        )
     if first is not None:
         if first < 2:
             raise SlamError(f"--first must be at least 2, got {first}")
