@@ -31,12 +31,12 @@ from typing import Any
 
 import numpy as np
 
-from roverlab.core import Context, Duration, Node, QoSProfile, Time
+from roverlab.core import Context, Duration, Node, QoSProfile
 from roverlab.geometry import Transform3
 from roverlab.mapping.gmapping.errors import GMappingInputError
 from roverlab.mapping.gmapping.params import GMappingParams
 from roverlab.mapping.gmapping.slam import GMapping
-from roverlab.mapping.laser import laser_geometry
+from roverlab.mapping.node_common import scan_inputs
 from roverlab.msgs import Float64, MapMetaData, OccupancyGrid
 from roverlab.msgs import classes as mc
 from roverlab.tf import (
@@ -115,22 +115,17 @@ class SlamGMapping(Node):
     def _on_scan(self, scan: Any) -> None:
         p = self.params
         self.scans_received += 1
-        stamp = Time.from_msg(scan.header.stamp)
-        frame = str(scan.header.frame_id).lstrip("/")
         try:
-            base_laser, _ = self.tf_buffer.lookup_transform(p.base_frame, frame, stamp)
-            odom_base, _ = self.tf_buffer.lookup_transform(p.odom_frame, p.base_frame, stamp)
+            stamp, laser, odom = scan_inputs(self.tf_buffer, scan, p.base_frame, p.odom_frame)
         except TransformException as err:
             self._throttle.warning("odom", f"Failed to compute odom pose, skipping scan ({err})")
             return
-        laser = laser_geometry(scan, base_laser)
         if not self._initialised:
             self._initialised = True
             if laser.upside_down:
                 self.get_logger().info("Laser is mounted upside down.")
             else:
                 self.get_logger().info("Laser is mounted upwards.")
-        odom = odom_base.to_se2()
         try:
             updated = self.slam.process(
                 np.asarray(scan.ranges, dtype=np.float64),

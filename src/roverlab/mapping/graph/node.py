@@ -28,12 +28,12 @@ from typing import Any
 
 import numpy as np
 
-from roverlab.core import Context, Node, QoSProfile, Time
+from roverlab.core import Context, Node, QoSProfile
 from roverlab.geometry import Transform3
 from roverlab.mapping.graph.errors import GraphSlamInputError
 from roverlab.mapping.graph.params import GraphParams
 from roverlab.mapping.graph.slam import GraphSLAM
-from roverlab.mapping.laser import laser_geometry
+from roverlab.mapping.node_common import scan_inputs
 from roverlab.msgs import MapMetaData, OccupancyGrid, array_to_occupancy_grid
 from roverlab.msgs import classes as mc
 from roverlab.tf import (
@@ -120,20 +120,16 @@ class SlamToolbox(Node):
 
     # ------------------------------------------------------------------ scans
     def _on_scan(self, scan: Any) -> None:
-        stamp = Time.from_msg(scan.header.stamp)
-        frame = str(scan.header.frame_id).lstrip("/")
         try:
-            base_laser, _ = self.tf_buffer.lookup_transform(self.base_frame, frame, stamp)
-            odom_base, _ = self.tf_buffer.lookup_transform(self.odom_frame, self.base_frame, stamp)
+            stamp, laser, odom = scan_inputs(self.tf_buffer, scan, self.base_frame, self.odom_frame)
         except TransformException as err:
             self._throttle.warning("odom", f"Failed to compute odom pose, skipping scan ({err})")
             return
-        laser = laser_geometry(scan, base_laser)
         try:
             self.slam.process(
                 np.asarray(scan.ranges, dtype=np.float64),
                 laser.angles,
-                odom_base.to_se2(),
+                odom,
                 stamp.nanoseconds / 1e9,
                 range_min=float(scan.range_min),
                 range_max=float(scan.range_max),
