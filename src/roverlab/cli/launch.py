@@ -99,7 +99,8 @@ def launch(
     path, args = _resolve(target)
     pace = parse_rate(rate)
     configure_logging()
-    mode, note = choose_clock(load_launch(path, args), clock, pace)
+    spec = load_launch(path, args)  # read once: <param command=...> runs commands (xacro)
+    mode, note = choose_clock(spec, clock, pace)
     if note:
         typer.echo(f"note: {note}", err=True)
     context = Context(clock=mode, rate=1.0 if math.isinf(pace) else pace)
@@ -108,7 +109,7 @@ def launch(
         if record is not None:
             recorder = McapRecorder(record)
             context.add_transport(recorder)
-        started = build_launch(path, args, context=context, seed=seed)
+        started = build_launch(spec, context=context, seed=seed)
         if expose:
             context.add_transport(ZenohTransport(network_options(ctx).zenoh_options()))
     except BaseException:

@@ -28,13 +28,14 @@ class Launch:
 
 
 def build_launch(
-    path: str | Path,
+    path: str | Path | LaunchSpec,
     args: Mapping[str, str] | None = None,
     *,
     context: Context,
     seed: int = 0,
 ) -> Launch:
-    """Read ``path`` and create its nodes in ``context``.
+    """Read ``path`` (or take an already read :class:`LaunchSpec`, ``args`` unused) and
+    create its nodes in ``context``.
 
     Nodes roverlab has no implementation of are skipped with a warning (ROS would fail to
     start them; skipping lets the rest of a launch file run). Parameters a node does not
@@ -43,7 +44,7 @@ def build_launch(
     Raises:
         LaunchError: a malformed file, a missing file or package, a bad node argument.
     """
-    spec = load_launch(path, args)
+    spec = path if isinstance(path, LaunchSpec) else load_launch(path, args)
     state = LaunchState(context=context, params=spec.params)
     launch = Launch(context=context, spec=spec)
     for node_spec in spec.nodes:
