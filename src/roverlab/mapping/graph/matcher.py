@@ -68,6 +68,24 @@ _VALID_POINT_SPACING = 0.1
 
 
 @_jit
+def _max_stamp(grid: NDArray[np.uint8], kernel: NDArray[np.uint8], x0: int, y0: int) -> None:
+    """``grid = max(grid, kernel)`` over the kernel placed with its corner at ``(x0, y0)``
+    (clipped to the grid)."""
+    h, w = grid.shape
+    k = kernel.shape[0]
+    for a in range(k):
+        y = y0 + a
+        if y < 0 or y >= h:
+            continue
+        for b in range(k):
+            x = x0 + b
+            if 0 <= x < w:
+                v = kernel[a, b]
+                if v > grid[y, x]:
+                    grid[y, x] = v
+
+
+@_jit
 def _splat(
     data: NDArray[np.uint8],
     pool: NDArray[np.uint8],
@@ -79,34 +97,9 @@ def _splat(
     block: int,
 ) -> None:
     """Max-splat the smear kernel (into ``data``) and the pooled kernel (into ``pool``)."""
-    h, w = data.shape
-    k = kernel.shape[0]
-    pk = pkernel.shape[0]
     for n in range(ix.shape[0]):
-        x0 = ix[n] - half
-        y0 = iy[n] - half
-        for a in range(k):
-            y = y0 + a
-            if y < 0 or y >= h:
-                continue
-            for b in range(k):
-                x = x0 + b
-                if 0 <= x < w:
-                    v = kernel[a, b]
-                    if v > data[y, x]:
-                        data[y, x] = v
-        x0 = ix[n] - half - block + 1
-        y0 = iy[n] - half - block + 1
-        for a in range(pk):
-            y = y0 + a
-            if y < 0 or y >= h:
-                continue
-            for b in range(pk):
-                x = x0 + b
-                if 0 <= x < w:
-                    v = pkernel[a, b]
-                    if v > pool[y, x]:
-                        pool[y, x] = v
+        _max_stamp(data, kernel, ix[n] - half, iy[n] - half)
+        _max_stamp(pool, pkernel, ix[n] - half - block + 1, iy[n] - half - block + 1)
 
 
 @_jit
