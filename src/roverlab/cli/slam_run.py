@@ -82,8 +82,8 @@ def hector_auto_size(records: LaserLog, params: dict[str, object]) -> dict[str, 
     bounding box (in the frame of the first pose) plus a margin."""
     if any(k in params for k in ("map_size", "map_start_x", "map_start_y")) or len(records) < 2:
         return params
-    res = float(params.get("map_resolution", HectorParams().map_resolution))  # type: ignore[arg-type]
-    levels = int(params.get("map_multi_res_levels", HectorParams().map_multi_res_levels))  # type: ignore[call-overload]
+    base = HectorParams.from_ros(params)  # the user's resolution and levels, else hector's
+    res, levels = base.map_resolution, base.map_multi_res_levels
     odo = records.odom_poses
     c, s = math.cos(odo[0, 2]), math.sin(odo[0, 2])
     d = odo[:, :2] - odo[0, :2]
@@ -95,7 +95,7 @@ def hector_auto_size(records: LaserLog, params: dict[str, object]) -> dict[str, 
     margin = _HECTOR_MARGIN_M + _HECTOR_MARGIN_SHARE * box
     span = box + 2 * margin
     step = 2 ** max(levels - 1, 0) * 64
-    cells = max(HectorParams().map_size, int(math.ceil(span / res / step)) * step)
+    cells = max(base.map_size, int(math.ceil(span / res / step)) * step)
     size_m = cells * res
     out = dict(params)
     out["map_size"] = cells
@@ -107,15 +107,15 @@ def hector_auto_size(records: LaserLog, params: dict[str, object]) -> dict[str, 
 
 def run_hector(records: LaserLog, params: dict[str, object]) -> MethodResult:
     sized = hector_auto_size(records, params)
+    hp = HectorParams.from_ros(sized)
     notes = []
     if sized is not params:
         notes.append(
-            f"hector map sized to the log: map_size {sized['map_size']} "
-            f"({float(sized['map_size']) * HectorParams.from_ros(sized).map_resolution:.1f} m), "  # type: ignore[arg-type]
-            f"map_start_x {float(sized['map_start_x']):.3f}, "  # type: ignore[arg-type]
-            f"map_start_y {float(sized['map_start_y']):.3f}"  # type: ignore[arg-type]
+            f"hector map sized to the log: map_size {hp.map_size} "
+            f"({hp.map_size * hp.map_resolution:.1f} m), map_start_x {hp.map_start_x:.3f}, "
+            f"map_start_y {hp.map_start_y:.3f}"
         )
-    result = HectorSLAM(HectorParams.from_ros(sized)).run_log(_progress(records, "hector"))
+    result = HectorSLAM(hp).run_log(_progress(records, "hector"))
     m = result.map
     return MethodResult(m.data, m.resolution, m.origin, result.poses, result.trajectory, notes)
 
