@@ -204,3 +204,13 @@ def test_bad_inputs_are_clear_errors(gt: GroundTruth) -> None:
         ground_truth(WORLD, resolution=-1.0, z_m=0.2)
     with pytest.raises(MapQualityError, match="nothing solid"):
         ground_truth(WORLD, resolution=RES, z_m=5.0)
+
+
+def test_a_non_finite_prior_or_search_window_is_an_error() -> None:
+    grid = OccupancyMapLike(data=np.array([[0, 100]], dtype=np.int8), origin_xy=(0.0, 0.0),
+                            resolution=0.05)  # fmt: skip
+    gt = GroundTruth(occupied=np.array([[False, True]]), origin_xy=(0.0, 0.0), resolution=0.05)
+    with pytest.raises(MapQualityError, match="prior pose must be finite"):
+        align_map(grid, gt, prior=SE2(math.nan, 0.0, 0.0))
+    with pytest.raises(MapQualityError, match="search windows must be >= 0"):
+        align_map(grid, gt, search_xy_m=math.nan)

@@ -353,12 +353,15 @@ def align_map(
         free_threshold: map values 0..this are free.
 
     Raises:
-        MapQualityError: a map without occupied or free cells, or bad thresholds.
+        MapQualityError: a map without occupied or free cells, bad thresholds, a
+            non-finite prior or search window.
     """
+    if not all(math.isfinite(v) for v in (prior.x, prior.y, prior.theta)):
+        raise MapQualityError(f"the prior pose must be finite, got {prior}")
     occ, free = _classify(grid, occupied_threshold, free_threshold)
     if not occ.any() or not free.any():
         raise MapQualityError("the map has no occupied or no free cells: nothing to align")
-    if search_xy_m < 0.0 or search_theta_rad < 0.0:
+    if not (search_xy_m >= 0.0 and search_theta_rad >= 0.0):  # NaN fails too
         raise MapQualityError("search windows must be >= 0")
     occ_pts = _centres(grid, occ)
     free_pts = _centres(grid, free)
