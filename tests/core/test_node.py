@@ -153,3 +153,24 @@ def test_malformed_parameter_file_names_file_and_line(tmp_path: Path) -> None:
         load_parameter_file(bad)
     with pytest.raises(ParameterError, match="cannot read"):
         load_parameter_file(tmp_path / "missing.yaml")
+
+
+def test_destroyed_publisher_subscription_and_timer_stop_working() -> None:
+    ctx = Context(publish_clock=False)
+    node = ctx.create_node("n")
+    pub = node.create_publisher(String, "/chatter", 10)
+    got: list[str] = []
+    ticks: list[int] = []
+    sub = node.create_subscription(String, "/chatter", lambda m: got.append(m.data), 10)
+    timer = node.create_timer(0.1, lambda: ticks.append(1))
+    pub.publish(String(data="a"))
+    ctx.spin_for(0.25)
+    assert got == ["a"] and len(ticks) == 2
+    sub.destroy()
+    timer.destroy()
+    pub.destroy()
+    # a topic with neither publishers nor subscriptions leaves the graph
+    assert pub not in node.publishers and "/chatter" not in ctx.graph.topics
+    ctx.create_node("m").create_publisher(String, "/chatter", 10).publish(String(data="b"))
+    ctx.spin_for(0.5)
+    assert got == ["a"] and len(ticks) == 2

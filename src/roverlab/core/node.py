@@ -98,6 +98,9 @@ class Publisher:
         another process: lets a publisher stop its timer while nobody listens."""
         self.topic.listener_watchers.append(callback)
 
+    def destroy(self) -> None:
+        self.node.destroy_publisher(self)
+
 
 def pausing_timer(
     node: Node, period_s: float, publisher: Publisher, tick: Callable[[], Any]
@@ -115,9 +118,6 @@ def pausing_timer(
 
     timer = node.create_timer(period_s, fire)
     return timer
-
-    def destroy(self) -> None:
-        self.node.destroy_publisher(self)
 
 
 class Subscription:
