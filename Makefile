@@ -28,6 +28,7 @@ test: lint
 	$(VENV)/bin/pytest -q
 
 bench: install
+	$(PY) -m pip install -q -e '.[bench]'
 	for b in benchmarks/*.py; do $(PY) $$b || exit 1; done
 
 clean:

@@ -376,7 +376,10 @@ def main() -> None:
     try:
         irsim = import_irsim()
     except Exception as exc:  # ImportError, or an import-time failure of its own
-        print(f"IR-SIM: not importable ({exc}); install the ir-sim package to compare. Skipped.")
+        print(
+            f"IR-SIM: not importable ({exc}); `pip install -e '.[bench]'` (make bench does) "
+            "to compare. Skipped."
+        )
     else:
         version = getattr(irsim, "__version__", "?")
         with tempfile.TemporaryDirectory(prefix="roverlab-bench-irsim-") as tmp:
