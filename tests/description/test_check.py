@@ -47,6 +47,9 @@ def test_check_lists_sensors_and_plugins() -> None:
     assert "---------- Gazebo plugins: 4 ---------------" in text
     assert "separation 0.18 m, diameter 0.05 m" in text
     assert "[libgazebo_ros_camera.so] on sensor 'csi Camera': /image_raw" in text
+    # the IMU plugin's own <imu><noise> block is what the simulation uses
+    assert "[libgazebo_ros_imu.so] on model: /imu from link imu in frame imu, " in text
+    assert "rate noise 0.0002, accel noise 0.017" in text
     assert "unsupported" not in text
 
 

@@ -102,6 +102,13 @@ def _plugin_line(p: GazeboPlugin) -> str:
         )
     elif isinstance(spec, ImuPluginSpec):
         detail = f": {spec.topic} from link {spec.body_name} in frame {spec.frame_id}"
+        if spec.noise is not None:
+            detail += (
+                f", rate noise {_num(spec.noise.rate.stddev)}, "
+                f"accel noise {_num(spec.noise.accel.stddev)}"
+            )
+        if spec.gaussian_noise:
+            detail += f", gaussianNoise {_num(spec.gaussian_noise)}"
     else:
         detail = ": not supported by roverlab (ignored)"
     return head + detail
