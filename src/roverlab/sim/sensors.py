@@ -143,8 +143,6 @@ class ImuModel:
         self.rng = rng
         self.rate_bias = self._bias(rate)
         self.accel_bias = self._bias(accel)
-        self._rate_bias = self.rate_bias.tolist()
-        self._accel_bias = self.accel_bias.tolist()
         self._block: list[list[float]] = []
         self._pos = 0
 
@@ -157,10 +155,20 @@ class ImuModel:
         sign = np.where(self.rng.random(3) < 0.5, -1.0, 1.0)
         return mag * sign
 
-    def _normals(self) -> list[float]:
-        """12 standard normals for one measurement, drawn in blocks (same sequence)."""
+    def _noise_row(self) -> list[float]:
+        """Bias + noise of one measurement: gyro x, y, z, accel x, y, z (gravity on z).
+
+        Drawn in blocks of 12 standard normals per measurement (6 for the ``<noise>``
+        stddevs, 6 for ``gaussianNoise``) and combined with numpy, once per block.
+        """
         if self._pos >= len(self._block):
-            self._block = self.rng.standard_normal((_BLOCK, 12)).tolist()
+            z = self.rng.standard_normal((_BLOCK, 12))
+            rn, an, g = self.rate_noise, self.accel_noise, self.gaussian_noise
+            rows = np.empty((_BLOCK, 6))
+            rows[:, :3] = (self.rate_bias + rn.mean) + rn.stddev * z[:, 0:3] + g * z[:, 6:9]
+            rows[:, 3:] = (self.accel_bias + an.mean) + an.stddev * z[:, 3:6] + g * z[:, 9:12]
+            rows[:, 5] += GRAVITY
+            self._block = rows.tolist()
             self._pos = 0
         row = self._block[self._pos]
         self._pos += 1
@@ -175,21 +183,13 @@ class ImuModel:
         the centripetal term ``v * w`` appears on y and gravity on z, as a real IMU reads.
         Plain floats: this runs at the IMU rate.
         """
-        z = self._normals()
-        rn, an, g = self.rate_noise, self.accel_noise, self.gaussian_noise
-        rb, ab = self._rate_bias, self._accel_bias
-        rm, rs, am, as_ = rn.mean, rn.stddev, an.mean, an.stddev
-        gyro = (
-            rb[0] + rm + rs * z[0] + g * z[6],
-            rb[1] + rm + rs * z[1] + g * z[7],
-            w + rb[2] + rm + rs * z[2] + g * z[8],
+        n = self._noise_row()
+        half = 0.5 * yaw
+        return (
+            (0.0, 0.0, math.sin(half), math.cos(half)),
+            (n[0], n[1], w + n[2]),
+            (dv_dt + n[3], v * w + n[4], n[5]),
         )
-        acc = (
-            dv_dt + ab[0] + am + as_ * z[3] + g * z[9],
-            v * w + ab[1] + am + as_ * z[4] + g * z[10],
-            GRAVITY + ab[2] + am + as_ * z[5] + g * z[11],
-        )
-        return (0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2)), gyro, acc
 
 
 @dataclass(frozen=True, slots=True)
