@@ -23,6 +23,7 @@ from roverlab.description.gazebo import (
     GazeboPlugin,
     GazeboSensor,
     ImuPluginSpec,
+    ImuSpec,
     KinectPluginSpec,
     LaserPluginSpec,
 )
@@ -74,10 +75,14 @@ def _sensor_line(s: GazeboSensor) -> str:
             f"{_num(c.clip_far)} m"
         )
     elif s.imu is not None:
-        detail = f": rate noise {_num(s.imu.rate.stddev)}, accel noise {_num(s.imu.accel.stddev)}"
+        detail = ": " + _imu_noise(s.imu)
     else:
         detail = ": not supported by roverlab"
     return head + detail + rate
+
+
+def _imu_noise(imu: ImuSpec) -> str:
+    return f"rate noise {_num(imu.rate.stddev)}, accel noise {_num(imu.accel.stddev)}"
 
 
 def _plugin_line(p: GazeboPlugin) -> str:
@@ -103,10 +108,7 @@ def _plugin_line(p: GazeboPlugin) -> str:
     elif isinstance(spec, ImuPluginSpec):
         detail = f": {spec.topic} from link {spec.body_name} in frame {spec.frame_id}"
         if spec.noise is not None:
-            detail += (
-                f", rate noise {_num(spec.noise.rate.stddev)}, "
-                f"accel noise {_num(spec.noise.accel.stddev)}"
-            )
+            detail += ", " + _imu_noise(spec.noise)
         if spec.gaussian_noise:
             detail += f", gaussianNoise {_num(spec.gaussian_noise)}"
     else:
