@@ -1,13 +1,15 @@
 """A roverlab process for transport tests: ``python node_proc.py MODE``.
 
 Modes: talker (/chatter at 50 Hz), pong (echo /ping to /pong), clock (paced sim
-publishing /clock), latched (/map latched once), listener (print /cmd_vel as lines).
+publishing /clock), latched (/map latched once), listener (print /cmd_vel as lines),
+services (/add_two_ints, and /fail whose callback raises).
 Prints READY on stdout once its nodes exist.
 """
 
 from __future__ import annotations
 
 import sys
+from typing import Any
 
 from roverlab.core import Context, QoSProfile
 from roverlab.core.transport.daemon import connect_context
@@ -35,6 +37,17 @@ def main(mode: str) -> None:
             String, "/map", QoSProfile(depth=1, durability="transient_local")
         )
         pub.publish(String(data="the map"))
+    elif mode == "services":
+
+        def add(req: Any, resp: Any) -> Any:
+            resp.sum = req.a + req.b
+            return resp
+
+        def fail(req: Any, resp: Any) -> Any:
+            raise RuntimeError("the callback broke")
+
+        node.create_service("rospy_tutorials/AddTwoInts", "/add_two_ints", add)
+        node.create_service("std_srvs/Trigger", "/fail", fail)
     elif mode == "listener":
 
         def show(m: object) -> None:
