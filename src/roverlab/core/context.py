@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import threading
+import time
 from collections.abc import Callable
 from typing import Any, Protocol
 
@@ -225,6 +226,35 @@ class Context:
         """Spin until ``future`` is done or a wall timeout passes; True if done (rclpy's
         ``spin_until_future_complete``)."""
         return self.spin_until_condition(future.done, timeout_sec=timeout_sec)
+
+    def wait_for(self, condition: Callable[[], bool], timeout_sec: float | None = None) -> bool:
+        """Block until ``condition()`` holds or ``timeout_sec`` of *clock* time passes (sim
+        time in a simulation; None: no timeout); True if it holds.
+
+        With an executor spinning in another thread this polls; with none spinning it spins
+        the executor here (in ``sim`` mode the wait costs no wall time). Called from a
+        callback it would block the executor that must make ``condition`` true: that is a
+        RuntimeError, not a deadlock.
+        """
+        ex = self.executor
+        tid = ex._thread_id
+        if tid == threading.get_ident():
+            raise RuntimeError(
+                "a blocking wait inside a callback would stop the executor it waits for; "
+                "use a callback (done_cb, add_done_callback) instead"
+            )
+        deadline = None if timeout_sec is None else ex.clock_now_ns() + round(timeout_sec * 1e9)
+        if tid is None:
+            self._check_nodes()
+            ex.spin(until_ns=deadline, stop_when=condition)
+            return condition()
+        while not condition():
+            if self._closed or ex.stopped:
+                return False
+            if deadline is not None and ex.clock_now_ns() >= deadline:
+                return condition()
+            time.sleep(0.002)
+        return True
 
     def spin_in_thread(self) -> threading.Thread:
         """Spin in a daemon thread (for scripts and CLIs); :meth:`shutdown` stops it."""

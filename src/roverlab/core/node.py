@@ -38,16 +38,20 @@ def message_type_name(msg_type: Any) -> str:
 
 
 class Clock:
-    """The node's view of the executor clock (ROS time: sim time inside a simulation)."""
+    """The node's view of the executor clock (ROS time: sim time inside a simulation).
+
+    Inside a callback it reads the event's time; from another thread, in the real-time
+    modes, the live clock (:meth:`Executor.clock_now_ns`).
+    """
 
     def __init__(self, executor: Executor) -> None:
         self._executor = executor
 
     def now(self) -> Time:
-        return Time(self._executor.now_ns)
+        return Time(self._executor.clock_now_ns())
 
     def now_ns(self) -> int:
-        return self._executor.now_ns
+        return self._executor.clock_now_ns()
 
 
 class Publisher:
