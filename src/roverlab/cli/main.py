@@ -7,7 +7,19 @@ from typing import Annotated
 
 import typer
 
-from roverlab.cli import daemon, demo, graph, launch, sim, slam_mapeval, slam_run, tf, topic
+from roverlab.cli import (
+    action,
+    daemon,
+    demo,
+    graph,
+    launch,
+    service,
+    sim,
+    slam_mapeval,
+    slam_run,
+    tf,
+    topic,
+)
 from roverlab.cli.common import NetworkOptions
 from roverlab.description import cli as urdf_cli
 from roverlab.errors import RoverlabError
@@ -24,6 +36,8 @@ app = typer.Typer(
     context_settings={"help_option_names": ["-h", "--help"]},
 )
 app.add_typer(topic.app, name="topic")
+app.add_typer(service.app, name="service")
+app.add_typer(action.app, name="action")
 app.add_typer(graph.node_app, name="node")
 app.add_typer(graph.param_app, name="param")
 app.add_typer(tf.app, name="tf")
