@@ -13,6 +13,7 @@ from roverlab.cli import (
     demo,
     graph,
     launch,
+    run,
     service,
     sim,
     slam_mapeval,
@@ -45,6 +46,10 @@ app.add_typer(daemon.app, name="daemon")
 app.command("demo")(demo.demo)
 app.command("sim")(sim.sim)
 app.command("launch")(launch.launch)
+app.command(
+    "run",
+    context_settings={"allow_extra_args": True, "ignore_unknown_options": True},
+)(run.run)
 app.command("dashboard")(viz_cli.dashboard)
 app.add_typer(urdf_cli.app, name="urdf")
 app.add_typer(map_cli.app, name="map")
