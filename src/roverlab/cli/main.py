@@ -7,7 +7,18 @@ from typing import Annotated
 
 import typer
 
-from roverlab.cli import daemon, demo, graph, launch, sim, slam_mapeval, slam_run, tf, topic
+from roverlab.cli import (
+    amcl_run,
+    daemon,
+    demo,
+    graph,
+    launch,
+    sim,
+    slam_mapeval,
+    slam_run,
+    tf,
+    topic,
+)
 from roverlab.cli.common import NetworkOptions
 from roverlab.description import cli as urdf_cli
 from roverlab.errors import RoverlabError
@@ -38,6 +49,7 @@ slam_cli.app.command("run")(slam_run.run)
 slam_cli.app.command("mapeval")(slam_mapeval.mapeval)
 app.add_typer(slam_cli.app, name="slam")
 app.command("teleop")(teleop_cli.teleop)
+app.add_typer(amcl_run.app, name="amcl")
 
 
 @app.callback()
