@@ -156,3 +156,41 @@ def test_user_password_auth_and_explicit_endpoints() -> None:
     finally:
         for c in (server_ctx, good_ctx, bad_ctx):
             c.shutdown()
+
+
+def test_service_call_across_processes(node_proc: Any) -> None:
+    from roverlab.core import ServiceError
+    from roverlab.msgs import get_service_type
+
+    node_proc("services")
+    ctx = Context(clock="wall")
+    node = ctx.create_node("caller")
+    transport = connect_context(ctx)
+    add = node.create_client("rospy_tutorials/AddTwoInts", "/add_two_ints")
+    fail = node.create_client("std_srvs/Trigger", "/fail")
+    wrong = node.create_client("std_srvs/Empty", "/add_two_ints")
+    missing = node.create_client("std_srvs/Empty", "/nobody_serves_this")
+    ctx.spin_in_thread()
+    try:
+        assert add.wait_for_service(timeout_sec=10)
+        assert fail.wait_for_service(timeout_sec=10)
+        req = get_service_type("rospy_tutorials/AddTwoInts").Request(a=20, b=22)
+        assert add.call(req, timeout_sec=5).sum == 42
+        future = add.call_async({"a": -1, "b": 1})
+        assert future.wait(5) and future.result().sum == 0
+        # a raising callback: one clear error for the caller; the server keeps serving
+        with pytest.raises(
+            ServiceError, match=r"service '/fail' failed: .*RuntimeError: the callback broke"
+        ):
+            fail.call({}, timeout_sec=5)
+        with pytest.raises(ServiceError, match="takes rospy_tutorials/srv/AddTwoInts_Request"):
+            wrong.call({}, timeout_sec=5)
+        assert add.call({"a": 1, "b": 2}, timeout_sec=5).sum == 3
+        assert missing.wait_for_service(timeout_sec=0.3) is False
+        services = {
+            (e.topic, e.typename) for e in query_graph(transport.session) if e.kind == "service"
+        }
+        assert ("/add_two_ints", "rospy_tutorials/srv/AddTwoInts") in services
+        assert ("/fail", "std_srvs/srv/Trigger") in services
+    finally:
+        ctx.shutdown()

@@ -1,17 +1,47 @@
 """A roverlab process for transport tests: ``python node_proc.py MODE``.
 
 Modes: talker (/chatter at 50 Hz), pong (echo /ping to /pong), clock (paced sim
-publishing /clock), latched (/map latched once), listener (print /cmd_vel as lines).
+publishing /clock), latched (/map latched once), listener (print /cmd_vel as lines),
+services (/add_two_ints, and /fail whose callback raises), fibonacci (the
+actionlib_tutorials Fibonacci action on /fibonacci, one step per 50 ms; order 13 aborts).
 Prints READY on stdout once its nodes exist.
 """
 
 from __future__ import annotations
 
 import sys
+from typing import Any
 
+from roverlab.actionlib import SimpleActionServer
 from roverlab.core import Context, QoSProfile
 from roverlab.core.transport.daemon import connect_context
 from roverlab.msgs import String, Twist
+
+
+def _fibonacci_server(node: Any) -> None:
+    server = SimpleActionServer(node, "/fibonacci", "actionlib_tutorials/FibonacciAction")
+    state: dict[str, Any] = {"order": 0, "seq": []}
+
+    def on_goal() -> None:
+        state["order"] = int(server.accept_new_goal().order)
+        state["seq"] = [0, 1]
+
+    def step() -> None:
+        if not server.is_active():
+            return
+        seq = state["seq"]
+        if server.is_preempt_requested():
+            server.set_preempted({"sequence": seq}, "canceled")
+        elif state["order"] == 13:
+            server.set_aborted(None, "13 is unlucky")
+        elif len(seq) - 2 >= state["order"]:
+            server.set_succeeded({"sequence": seq}, "done")
+        else:
+            seq.append(seq[-1] + seq[-2])
+            server.publish_feedback({"sequence": seq})
+
+    server.register_goal_callback(on_goal)
+    node.create_timer(0.05, step)
 
 
 def main(mode: str) -> None:
@@ -35,6 +65,19 @@ def main(mode: str) -> None:
             String, "/map", QoSProfile(depth=1, durability="transient_local")
         )
         pub.publish(String(data="the map"))
+    elif mode == "services":
+
+        def add(req: Any, resp: Any) -> Any:
+            resp.sum = req.a + req.b
+            return resp
+
+        def fail(req: Any, resp: Any) -> Any:
+            raise RuntimeError("the callback broke")
+
+        node.create_service("rospy_tutorials/AddTwoInts", "/add_two_ints", add)
+        node.create_service("std_srvs/Trigger", "/fail", fail)
+    elif mode == "fibonacci":
+        _fibonacci_server(node)
     elif mode == "listener":
 
         def show(m: object) -> None:

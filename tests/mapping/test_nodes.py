@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from roverlab.core import Context, Node, QoSProfile, Time
+from roverlab.core import Context, Node, QoSProfile, ServiceError, Time
 from roverlab.geometry import SE2, Transform3
 from roverlab.launch import LaunchError, build_launch
 from roverlab.mapping.gmapping import GMappingParams
@@ -174,6 +174,9 @@ def test_gmapping_waits_for_tf_and_drops_with_a_warning(caplog: pytest.LogCaptur
     ctx = Context()
     robot = FakeRobot(ctx, SE2(-0.5, 0.2, 0.3))
     node = SlamGMapping(ctx, parameter_overrides={"particles": 4, "temporalUpdate": 0.5})
+    dynamic_map = ctx.create_node("caller").create_client("nav_msgs/GetMap", "dynamic_map")
+    with pytest.raises(ServiceError, match="no map has been built yet"):
+        dynamic_map.call({})
     with caplog.at_level(logging.WARNING, logger="roverlab"):
         ctx.spin_for(1.05)  # ten scans, no TF: five wait, the rest are dropped
     assert node.scans_received == 0 and node.scan_filter.waiting == 5
@@ -185,6 +188,7 @@ def test_gmapping_waits_for_tf_and_drops_with_a_warning(caplog: pytest.LogCaptur
     # the waiting scans are older than the first TF: dropped; the new ones go through
     assert node.scans_received >= 15 and node.map_msg is not None
     assert node.scans_processed >= 4  # temporalUpdate 0.5 s
+    assert dynamic_map.call({}).map is node.map_msg  # the dynamic_map service
     # the first scan placed the map at the odometry frame's origin: map -> odom = identity
     tf = node.map_to_odom.to_se2()
     assert math.hypot(tf.x, tf.y) < 0.03 and abs(tf.theta) < 0.02
@@ -353,7 +357,9 @@ def test_seed_launch_files_start_the_nodes() -> None:
     assert node2.params.map_size == 2048 and node2.params.map_multi_res_levels == 2
     assert node2.params.update_factor_occupied == 0.7 and node2.base_frame == "base_footprint"
     (warning,) = hec.warnings
-    assert "hector.launch" in warning and "advertise_map_service, output_timing" in warning
+    assert "hector.launch" in warning and "output_timing" in warning
+    assert "advertise_map_service" not in warning
+    assert "/dynamic_map" in ctx2.graph.services
 
 
 def test_bad_and_unknown_launch_params(tmp_path: Path) -> None:

@@ -52,6 +52,20 @@ def test_map_server_latches_map_for_late_subscribers(map_file: tuple[Path, np.nd
     ctx.shutdown()
 
 
+def test_map_server_static_map_service(map_file: tuple[Path, np.ndarray]) -> None:
+    path, data = map_file
+    ctx = Context()
+    MapServer(ctx, yaml_path=path)
+    client = ctx.create_node("amcl").create_client("nav_msgs/GetMap", "static_map")
+    assert client.wait_for_service(timeout_sec=0.0)
+    future = client.call_async({})
+    assert ctx.spin_until_future_complete(future, timeout_sec=5)
+    got = future.result().map
+    assert np.array_equal(occupancy_grid_to_array(got), data)
+    assert got.header.frame_id == "map" and got.info.width == 31
+    ctx.shutdown()
+
+
 def test_map_server_frame_id_parameter(map_file: tuple[Path, np.ndarray]) -> None:
     path, _ = map_file
     ctx = Context()

@@ -61,7 +61,7 @@ def test_unknown_type_without_suggestion_is_one_line() -> None:
     assert "'zzz_pkg/msg/Qqqqqq'" in str(info.value)
 
 
-@pytest.mark.parametrize("bad", ["", "a/b/c/d", "geometry_msgs/srv/Twist", "geometry msgs/Twist"])
+@pytest.mark.parametrize("bad", ["", "a/b/c/d", "geometry_msgs/foo/Twist", "geometry msgs/Twist"])
 def test_malformed_names_rejected(bad: str) -> None:
     with pytest.raises(UnknownTypeError, match="not a message type name"):
         normalize_type_name(bad)
@@ -70,3 +70,9 @@ def test_malformed_names_rejected(bad: str) -> None:
 def test_non_type_object_rejected() -> None:
     with pytest.raises(UnknownTypeError, match="not a message type"):
         get_type(42)
+
+
+def test_service_message_names_are_names() -> None:
+    assert normalize_type_name("std_srvs/srv/Empty_Request") == "std_srvs/srv/Empty_Request"
+    with pytest.raises(UnknownTypeError, match="unknown message type 'geometry_msgs/srv/Twist'"):
+        get_type("geometry_msgs/srv/Twist")

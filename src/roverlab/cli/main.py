@@ -8,11 +8,13 @@ from typing import Annotated
 import typer
 
 from roverlab.cli import (
+    action,
     amcl_run,
     daemon,
     demo,
     graph,
     launch,
+    service,
     sim,
     slam_mapeval,
     slam_run,
@@ -35,6 +37,8 @@ app = typer.Typer(
     context_settings={"help_option_names": ["-h", "--help"]},
 )
 app.add_typer(topic.app, name="topic")
+app.add_typer(service.app, name="service")
+app.add_typer(action.app, name="action")
 app.add_typer(graph.node_app, name="node")
 app.add_typer(graph.param_app, name="param")
 app.add_typer(tf.app, name="tf")

@@ -17,6 +17,8 @@ from roverlab.core.errors import (
     GraphError,
     InvalidTopicNameError,
     ParameterError,
+    ServiceError,
+    ServiceUnavailableError,
     TopicTypeError,
     TransportError,
 )
@@ -32,14 +34,17 @@ from roverlab.core.parameters import (
     parameters_for_node,
 )
 from roverlab.core.qos import QoSProfile
+from roverlab.core.services import Client, Future, Service
 from roverlab.core.time import Duration, Time
 
 __all__ = [
+    "Client",
     "Clock",
     "ClockMode",
     "Context",
     "Duration",
     "Executor",
+    "Future",
     "GraphError",
     "InvalidTopicNameError",
     "Node",
@@ -50,6 +55,9 @@ __all__ = [
     "ParameterType",
     "Publisher",
     "QoSProfile",
+    "Service",
+    "ServiceError",
+    "ServiceUnavailableError",
     "SetParametersResult",
     "Subscription",
     "Time",

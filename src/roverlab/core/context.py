@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import threading
+import time
 from collections.abc import Callable
 from typing import Any, Protocol
 
@@ -13,6 +14,7 @@ from roverlab.core.graph import TopicGraph
 from roverlab.core.log import NodeLogger
 from roverlab.core.node import Node, Publisher, Subscription, pausing_timer
 from roverlab.core.qos import QoSProfile
+from roverlab.core.services import Client, Future, Service, ServiceTransport
 from roverlab.core.time import Duration, Time
 from roverlab.msgs import classes as mc
 
@@ -150,6 +152,16 @@ class Context:
             t.on_subscription(sub, False)
         self.graph.prune(sub.topic)
 
+    def _on_service(self, service: Service, added: bool) -> None:
+        for t in self.transports:
+            if isinstance(t, ServiceTransport):
+                t.on_service(service, added)
+
+    def _on_client(self, client: Client, added: bool) -> None:
+        for t in self.transports:
+            if isinstance(t, ServiceTransport):
+                t.on_client(client, added)
+
     def _callback_error(self, owner: Any, err: BaseException) -> None:
         node = getattr(owner, "node", None)
         logger = node.get_logger() if node is not None else self._logger
@@ -172,6 +184,11 @@ class Context:
                 transport.on_publisher(pub, True)
             for sub in node.subscriptions:
                 transport.on_subscription(sub, True)
+            if isinstance(transport, ServiceTransport):
+                for service in node.services:
+                    transport.on_service(service, True)
+                for client in node.clients:
+                    transport.on_client(client, True)
 
     # ----------------------------------------------------------------- spinning
     def _check_nodes(self) -> None:
@@ -204,6 +221,40 @@ class Context:
         self._check_nodes()
         self.executor.spin(stop_when=condition, wall_timeout_s=timeout_sec)
         return condition()
+
+    def spin_until_future_complete(self, future: Future, timeout_sec: float | None = None) -> bool:
+        """Spin until ``future`` is done or a wall timeout passes; True if done (rclpy's
+        ``spin_until_future_complete``)."""
+        return self.spin_until_condition(future.done, timeout_sec=timeout_sec)
+
+    def wait_for(self, condition: Callable[[], bool], timeout_sec: float | None = None) -> bool:
+        """Block until ``condition()`` holds or ``timeout_sec`` of *clock* time passes (sim
+        time in a simulation; None: no timeout); True if it holds.
+
+        With an executor spinning in another thread this polls; with none spinning it spins
+        the executor here (in ``sim`` mode the wait costs no wall time). Called from a
+        callback it would block the executor that must make ``condition`` true: that is a
+        RuntimeError, not a deadlock.
+        """
+        ex = self.executor
+        tid = ex._thread_id
+        if tid == threading.get_ident():
+            raise RuntimeError(
+                "a blocking wait inside a callback would stop the executor it waits for; "
+                "use a callback (done_cb, add_done_callback) instead"
+            )
+        deadline = None if timeout_sec is None else ex.clock_now_ns() + round(timeout_sec * 1e9)
+        if tid is None:
+            self._check_nodes()
+            ex.spin(until_ns=deadline, stop_when=condition)
+            return condition()
+        while not condition():
+            if self._closed or ex.stopped:
+                return False
+            if deadline is not None and ex.clock_now_ns() >= deadline:
+                return condition()
+            time.sleep(0.002)
+        return True
 
     def spin_in_thread(self) -> threading.Thread:
         """Spin in a daemon thread (for scripts and CLIs); :meth:`shutdown` stops it."""

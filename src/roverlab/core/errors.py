@@ -8,6 +8,8 @@ __all__ = [
     "GraphError",
     "InvalidTopicNameError",
     "ParameterError",
+    "ServiceError",
+    "ServiceUnavailableError",
     "TopicTypeError",
     "TransportError",
 ]
@@ -31,3 +33,12 @@ class ParameterError(RoverlabError):
 
 class TransportError(RoverlabError):
     """The inter-process transport could not be opened or failed."""
+
+
+class ServiceError(RoverlabError):
+    """A service call failed: the server's callback raised, or its answer was not a
+    response of the service's type, or no answer came."""
+
+
+class ServiceUnavailableError(ServiceError):
+    """No server of the service is known (in this process or, over a transport, another)."""

@@ -143,6 +143,18 @@ class Executor:
             return sim0 + int((time.perf_counter_ns() - wall0) * self.rate)
         return self.now_ns
 
+    def clock_now_ns(self) -> int:
+        """The clock as a caller sees it: inside a callback, the event's time; from another
+        thread (or while nothing spins) in the real-time modes, the live clock."""
+        tid = self._thread_id
+        if tid is not None and tid == threading.get_ident():
+            return self.now_ns
+        if self.mode is ClockMode.WALL:
+            return max(self.now_ns, time.time_ns())
+        if self.mode is ClockMode.PACED and self._pace_origin is not None:
+            return max(self.now_ns, self._wall_now())
+        return self.now_ns
+
     def set_external_time(self, t_ns: int) -> None:
         """Advance an ``external`` clock (called with each /clock message)."""
         if t_ns > self.now_ns:

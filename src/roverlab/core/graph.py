@@ -11,6 +11,7 @@ from roverlab.core.errors import InvalidTopicNameError, TopicTypeError
 
 if TYPE_CHECKING:
     from roverlab.core.node import Publisher, Subscription
+    from roverlab.core.services import Service
 
 __all__ = ["Topic", "TopicGraph", "resolve_name", "validate_node_name"]
 
@@ -98,10 +99,35 @@ class Topic:
 
 
 class TopicGraph:
-    """Topics of one context, keyed by resolved name, each with one message type."""
+    """Topics of one context, keyed by resolved name, each with one message type; and
+    its service servers, one per resolved service name."""
 
     def __init__(self) -> None:
         self.topics: dict[str, Topic] = {}
+        self.services: dict[str, Service] = {}
+        self._shadowed: dict[str, list[Service]] = {}
+
+    def add_service(self, service: Service) -> Service | None:
+        """Make ``service`` the server of its name; returns the one it takes over from
+        (ROS 1's master does the same: the newest registration serves, with a warning)."""
+        other = self.services.get(service.srv_name)
+        if other is not None:
+            self._shadowed.setdefault(service.srv_name, []).append(other)
+        self.services[service.srv_name] = service
+        return other
+
+    def remove_service(self, service: Service) -> None:
+        name = service.srv_name
+        older = self._shadowed.get(name, [])
+        if service in older:
+            older.remove(service)
+        elif self.services.get(name) is service:
+            if older:
+                self.services[name] = older.pop()
+            else:
+                del self.services[name]
+        if not older:
+            self._shadowed.pop(name, None)
 
     def get(self, name: str, typename: str) -> Topic:
         topic = self.topics.get(name)

@@ -19,8 +19,9 @@ from roverlab.core.parameters import (
     SetParametersResult,
 )
 from roverlab.core.qos import QoSProfile, qos_profile
+from roverlab.core.services import Client, Service, ServiceCallback
 from roverlab.core.time import Duration, Time
-from roverlab.msgs import normalize_type_name, type_name
+from roverlab.msgs import get_service_type, normalize_type_name, type_name
 
 if TYPE_CHECKING:
     from roverlab.core.context import Context
@@ -37,16 +38,20 @@ def message_type_name(msg_type: Any) -> str:
 
 
 class Clock:
-    """The node's view of the executor clock (ROS time: sim time inside a simulation)."""
+    """The node's view of the executor clock (ROS time: sim time inside a simulation).
+
+    Inside a callback it reads the event's time; from another thread, in the real-time
+    modes, the live clock (:meth:`Executor.clock_now_ns`).
+    """
 
     def __init__(self, executor: Executor) -> None:
         self._executor = executor
 
     def now(self) -> Time:
-        return Time(self._executor.now_ns)
+        return Time(self._executor.clock_now_ns())
 
     def now_ns(self) -> int:
-        return self._executor.now_ns
+        return self._executor.clock_now_ns()
 
 
 class Publisher:
@@ -262,6 +267,8 @@ class Node:
         self.publishers: list[Publisher] = []
         self.subscriptions: list[Subscription] = []
         self.timers: list[Timer] = []
+        self.services: list[Service] = []
+        self.clients: list[Client] = []
         self._destroyed = False
         context._add_node(self)
         self.declare_parameter("use_sim_time", context.uses_sim_time)
@@ -331,6 +338,45 @@ class Node:
         self.timers.append(timer)
         return timer
 
+    def create_service(self, srv_type: Any, srv_name: str, callback: ServiceCallback) -> Service:
+        """Serve ``srv_name``: ``callback(request, response)`` returns the response.
+
+        ``srv_type`` is a :class:`~roverlab.msgs.ServiceType` or its name in the ROS 1 or 2
+        spelling (``"std_srvs/Empty"``, ``"std_srvs/srv/Empty"``). A second server of the
+        same name in a process takes over from the first until it is destroyed, with a
+        warning (ROS 1's rule).
+        """
+        service = Service(
+            self, get_service_type(srv_type), self.resolve_topic_name(srv_name), callback
+        )
+        replaced = self.context.graph.add_service(service)
+        if replaced is not None:
+            self.get_logger().warning(
+                f"service '{service.srv_name}' was served by "
+                f"'{replaced.node.get_fully_qualified_name()}': this node serves it now"
+            )
+        self.services.append(service)
+        self.context._on_service(service, True)
+        return service
+
+    def create_client(self, srv_type: Any, srv_name: str) -> Client:
+        """A client of ``srv_name`` (``call``, ``call_async``, ``wait_for_service``)."""
+        client = Client(self, get_service_type(srv_type), self.resolve_topic_name(srv_name))
+        self.clients.append(client)
+        self.context._on_client(client, True)
+        return client
+
+    def destroy_service(self, service: Service) -> None:
+        if service in self.services:
+            self.services.remove(service)
+            self.context.graph.remove_service(service)
+            self.context._on_service(service, False)
+
+    def destroy_client(self, client: Client) -> None:
+        if client in self.clients:
+            self.clients.remove(client)
+            self.context._on_client(client, False)
+
     def destroy_publisher(self, pub: Publisher) -> None:
         if pub in self.publishers:
             self.publishers.remove(pub)
@@ -358,6 +404,10 @@ class Node:
             self.destroy_subscription(sub)
         for timer in list(self.timers):
             self.destroy_timer(timer)
+        for service in list(self.services):
+            self.destroy_service(service)
+        for client in list(self.clients):
+            self.destroy_client(client)
         self._destroyed = True
         self.context._remove_node(self)
 

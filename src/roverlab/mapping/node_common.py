@@ -1,15 +1,30 @@
-"""What the SLAM nodes share: a scan's TF inputs (node side: uses the TF buffer)."""
+"""What the SLAM nodes share: a scan's TF inputs and the dynamic_map service."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
-from roverlab.core import Time
+from roverlab.core import Node, Service, Time
 from roverlab.geometry import SE2
 from roverlab.mapping.laser import LaserGeometry, laser_geometry
 from roverlab.tf import Buffer
 
-__all__ = ["scan_inputs"]
+__all__ = ["advertise_map_service", "scan_inputs"]
+
+
+def advertise_map_service(node: Node, current_map: Callable[[], Any]) -> Service:
+    """The ``dynamic_map`` service (``nav_msgs/GetMap``) of a SLAM node: the last map it
+    published. Before the first map the call fails, as gmapping's and karto's do."""
+
+    def on_request(_request: Any, response: Any) -> Any:
+        msg = current_map()
+        if msg is None:
+            raise RuntimeError("no map has been built yet")
+        response.map = msg
+        return response
+
+    return node.create_service("nav_msgs/GetMap", "dynamic_map", on_request)
 
 
 def scan_inputs(

@@ -3,7 +3,8 @@
 MapServer (ROS 1 ``map_server``)
     loads ``NAME.yaml`` and publishes the map once, latched, on ``map``
     (``nav_msgs/OccupancyGrid``) and ``map_metadata`` (``nav_msgs/MapMetaData``), stamped
-    with the load time, in frame ``frame_id``.
+    with the load time, in frame ``frame_id``; the ``static_map`` service
+    (``nav_msgs/GetMap``) answers with the same map.
 
 MapSaver (ROS 1 ``map_saver -f NAME``)
     waits for one message on ``map`` and writes ``NAME.pgm`` and ``NAME.yaml``, reporting
@@ -69,10 +70,17 @@ class MapServer(Node):
         self.map_publisher = self.create_publisher(OccupancyGrid, "map", _LATCHED)
         self.metadata_publisher.publish(self.metadata_msg)
         self.map_publisher.publish(self.map_msg)
+        self.static_map_service = self.create_service(
+            "nav_msgs/GetMap", "static_map", self._on_static_map
+        )
         self.get_logger().info(
             f"Read a {self.map.width} X {self.map.height} map @ "
             f"{self.map.info.resolution:.3f} m/cell"
         )
+
+    def _on_static_map(self, _request: Any, response: Any) -> Any:
+        response.map = self.map_msg
+        return response
 
 
 class MapSaver(Node):

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import difflib
 import keyword
+import threading
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from enum import Enum
 from typing import Any, Final
@@ -21,6 +23,7 @@ from rosbags.typesys.store import Typestore
 from .errors import UnknownTypeError
 
 __all__ = [
+    "INTERFACE_KINDS",
     "STORE",
     "FieldKind",
     "FieldSpec",
@@ -138,11 +141,17 @@ class TypeSpec:
         return tuple(self.by_name.values())
 
 
+#: The middle part of a full type name: messages, and the request/response messages of
+#: services (``std_srvs/srv/Empty_Request``).
+INTERFACE_KINDS: Final = ("msg", "srv", "action")
+
+
 def normalize_type_name(name: str) -> str:
     """Normalise a message type name to the ROS 2 form ``pkg/msg/Name``.
 
     Accepts ``geometry_msgs/msg/Twist``, the ROS 1 form ``geometry_msgs/Twist`` and the
-    Python module form ``geometry_msgs.msg.Twist``. The type need not exist.
+    Python module form ``geometry_msgs.msg.Twist``; also the message types of services
+    (``std_srvs/srv/Empty_Request``). The type need not exist.
 
     Args:
         name: Type name in any accepted form.
@@ -157,7 +166,11 @@ def normalize_type_name(name: str) -> str:
     parts = text.replace(".", "/").split("/") if "/" not in text else text.split("/")
     if len(parts) == 2:
         parts = [parts[0], "msg", parts[1]]
-    if len(parts) != 3 or parts[1] != "msg" or not all(p.isidentifier() for p in parts):
+    if (
+        len(parts) != 3
+        or parts[1] not in INTERFACE_KINDS
+        or not all(p.isidentifier() for p in parts)
+    ):
         raise UnknownTypeError(
             f"not a message type name: {name!r} (expected pkg/msg/Name){STORE.suggest(text)}"
         )
@@ -219,8 +232,63 @@ class MessageStore:
         self._canonical: dict[str, str] = {}
         self._specs: dict[str, TypeSpec] = {}
         self._short_index: dict[str, list[str]] = {}
+        self._sources: list[Callable[[str], bool]] = []
+        self._lock = threading.RLock()
         for full in typestore.types:
-            self._short_index.setdefault(full.rsplit("/", 1)[-1].lower(), []).append(full)
+            self._index(full)
+
+    def _index(self, full: str) -> None:
+        self._short_index.setdefault(full.rsplit("/", 1)[-1].lower(), []).append(full)
+
+    def register(self, typedefs: Mapping[str, Any]) -> list[str]:
+        """Add type definitions (rosbags ``Typesdict``) to the store.
+
+        A type already in the store with the same definition is left alone; a different
+        definition under a known name is an error (messages on the wire would not match).
+
+        Returns:
+            The names that were new.
+
+        Raises:
+            UnknownTypeError: A name clashes with a different existing definition, or a
+                field refers to a type that is neither known nor in ``typedefs``.
+        """
+        with self._lock:
+            fielddefs = self.typestore.fielddefs
+            new = {k: v for k, v in typedefs.items() if k not in fielddefs}
+            for name, definition in typedefs.items():
+                if name in fielddefs and fielddefs[name] != definition:
+                    raise UnknownTypeError(
+                        f"type {name} is already defined differently; cannot register it again"
+                    )
+            if not new:
+                return []
+            for name, (_consts, fields) in new.items():
+                for fname, desc in fields:
+                    ref = _referenced_type(desc)
+                    if ref is None or ref in new or ref in fielddefs:
+                        continue
+                    if not self._try_sources(ref):
+                        raise UnknownTypeError(
+                            f"type {name}: field {fname!r} refers to unknown type {ref}"
+                        )
+            try:
+                self.typestore.register(new)
+            except Exception as err:  # rosbags raises its own TypesysError kinds
+                raise UnknownTypeError(f"cannot register {', '.join(sorted(new))}: {err}") from err
+            for name in new:
+                self._index(name)
+            return sorted(new)
+
+    def add_type_source(self, source: Callable[[str], bool]) -> None:
+        """Consult ``source(full_name)`` when a type is not in the store; it returns True
+        after registering types (lazy loading of interface packages)."""
+        self._sources.append(source)
+
+    def _try_sources(self, full: str) -> bool:
+        return any(source(full) for source in list(self._sources)) and (
+            full in self.typestore.types
+        )
 
     def typenames(self) -> list[str]:
         """All type names of the store, sorted."""
@@ -251,7 +319,7 @@ class MessageStore:
         if found is not None:
             return found
         full = normalize_type_name(key)
-        if full not in self.typestore.types:
+        if full not in self.typestore.types and not self._try_sources(full):
             raise UnknownTypeError(f"unknown message type {key!r}{self.suggest(key)}")
         self._canonical[key] = full
         return full
@@ -286,6 +354,18 @@ class MessageStore:
             by_name={f.name: f for f in fields if f.name != PLACEHOLDER_FIELD},
             constants={name: value for name, _typ, value in consts},
         )
+
+
+def _referenced_type(desc: Any) -> str | None:
+    """The message type a rosbags field description refers to, or None for base types."""
+    node = desc[0]
+    if node == Nodetype.NAME:
+        return str(desc[1])
+    if node in (Nodetype.ARRAY, Nodetype.SEQUENCE):
+        sub_node, sub = desc[1][0]
+        if sub_node == Nodetype.NAME:
+            return str(sub)
+    return None
 
 
 def _key(ref: object) -> str:

@@ -14,6 +14,8 @@ Key layout (``D`` is the domain, ``ROVERLAB_DOMAIN_ID``, default 0; like ``ROS_D
                                        (``.../<topic>/<type>``); ``/`` in names is
                                        written ``%``
 ``rl/D/p/<node>``                      parameter service of a node (JSON queries)
+``rl/D/v/<service>``                   a service server's queryable (CDR request and
+                                       response): :mod:`.zenoh_services`
 =====================================  ================================================
 
 Messages that stay inside a process never touch Zenoh: a topic is serialised only while
@@ -35,11 +37,13 @@ from typing import TYPE_CHECKING, Any
 import zenoh
 
 from roverlab.core.errors import ParameterError, TransportError
+from roverlab.core.transport.zenoh_services import ZenohServices
 from roverlab.msgs import deserialize, serialize
 
 if TYPE_CHECKING:
     from roverlab.core.context import Context
     from roverlab.core.node import Node, Publisher, Subscription
+    from roverlab.core.services import Client, Future, Service
 
 __all__ = [
     "DEFAULT_DAEMON_ENDPOINT",
@@ -200,9 +204,15 @@ class ZenohTransport:
         self.received = 0
         self.sent = 0
         self.dropped_wrong_type = 0
+        self._services = ZenohServices(self)
+
+    @property
+    def context(self) -> Context | None:
+        return self._context
 
     # ----------------------------------------------------------------- keys
-    def _g(self, kind: str, *parts: str) -> str:
+    def graph_key(self, kind: str, *parts: str) -> str:
+        """This process's liveliness key of a graph entity (``kind`` n, p, s, v or c)."""
         return f"rl/{self.domain}/g/{self.zid}/{kind}/" + "/".join(encode_name(p) for p in parts)
 
     def _link(self, topic: str) -> _TopicLink:
@@ -220,7 +230,7 @@ class ZenohTransport:
         fq = node.get_fully_qualified_name()
         with self._lock:
             if added:
-                token = self.session.liveliness().declare_token(self._g("n", fq))
+                token = self.session.liveliness().declare_token(self.graph_key("n", fq))
                 queryable = self.session.declare_queryable(
                     f"rl/{self.domain}/p/{encode_name(fq)}",
                     partial(self._on_param_query, node),
@@ -244,7 +254,9 @@ class ZenohTransport:
                         key, partial(self._on_latched_query, topic)
                     )
                 link.tokens[pub] = self.session.liveliness().declare_token(
-                    self._g("p", pub.node.get_fully_qualified_name(), topic.name, topic.typename)
+                    self.graph_key(
+                        "p", pub.node.get_fully_qualified_name(), topic.name, topic.typename
+                    )
                     + ("/latched" if pub.qos.latched else "/volatile")
                 )
             else:
@@ -267,7 +279,9 @@ class ZenohTransport:
             link = self._link(topic.name)
             if added:
                 link.tokens[sub] = self.session.liveliness().declare_token(
-                    self._g("s", sub.node.get_fully_qualified_name(), topic.name, topic.typename)
+                    self.graph_key(
+                        "s", sub.node.get_fully_qualified_name(), topic.name, topic.typename
+                    )
                 )
                 if link.subscriber is None:
                     link.subscriber = self.session.declare_subscriber(
@@ -290,7 +304,21 @@ class ZenohTransport:
                     link.subscriber.undeclare()
                     link.subscriber = None
 
+    # ----------------------------------------------------------------- services
+    def on_service(self, service: Service, added: bool) -> None:
+        self._services.on_service(service, added)
+
+    def on_client(self, client: Client, added: bool) -> None:
+        self._services.on_client(client, added)
+
+    def service_available(self, name: str) -> bool:
+        return self._services.service_available(name)
+
+    def call_service(self, client: Client, request: Any, future: Future) -> bool:
+        return self._services.call_service(client, request, future)
+
     def close(self) -> None:
+        self._services.close()
         with self._lock:
             self._links.clear()
             self._node_entities.clear()
@@ -441,11 +469,14 @@ class GraphEntity:
     """One liveliness token of the graph, decoded."""
 
     zid: str
-    kind: str  # "node", "publisher" or "subscription"
+    kind: str  # "node", "publisher", "subscription", "service" or "client"
     node: str
-    topic: str = ""
+    topic: str = ""  # the topic, or the service's name
     typename: str = ""
     latched: bool = False
+
+
+_ENTITY_KINDS = {"p": "publisher", "s": "subscription", "v": "service", "c": "client"}
 
 
 def parse_graph_key(key: str) -> GraphEntity | None:
@@ -456,10 +487,10 @@ def parse_graph_key(key: str) -> GraphEntity | None:
     zid, kind, node = parts[3], parts[4], decode_name(parts[5])
     if kind == "n":
         return GraphEntity(zid, "node", node)
-    if kind in ("p", "s") and len(parts) >= 8:
+    if kind in _ENTITY_KINDS and len(parts) >= 8:
         return GraphEntity(
             zid,
-            "publisher" if kind == "p" else "subscription",
+            _ENTITY_KINDS[kind],
             node,
             decode_name(parts[6]),
             decode_name(parts[7]),

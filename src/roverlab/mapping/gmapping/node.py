@@ -36,7 +36,7 @@ from roverlab.geometry import Transform3
 from roverlab.mapping.gmapping.errors import GMappingInputError
 from roverlab.mapping.gmapping.params import GMappingParams
 from roverlab.mapping.gmapping.slam import GMapping
-from roverlab.mapping.node_common import scan_inputs
+from roverlab.mapping.node_common import advertise_map_service, scan_inputs
 from roverlab.msgs import Float64, MapMetaData, OccupancyGrid
 from roverlab.msgs import classes as mc
 from roverlab.tf import (
@@ -101,6 +101,7 @@ class SlamGMapping(Node):
         self.tf_listener = TransformListener(self.tf_buffer, self)
         self.tf_broadcaster = TransformBroadcaster(self)
         self.map_publisher = self.create_publisher(OccupancyGrid, "map", _LATCHED)
+        self.map_service = advertise_map_service(self, lambda: self.map_msg)
         self.metadata_publisher = self.create_publisher(MapMetaData, "map_metadata", _LATCHED)
         self.entropy_publisher = self.create_publisher(Float64, "~entropy", 10)
         self.scan_filter = TfMessageFilter(

@@ -33,7 +33,7 @@ from roverlab.geometry import Transform3
 from roverlab.mapping.graph.errors import GraphSlamInputError
 from roverlab.mapping.graph.params import GraphParams
 from roverlab.mapping.graph.slam import GraphSLAM
-from roverlab.mapping.node_common import scan_inputs
+from roverlab.mapping.node_common import advertise_map_service, scan_inputs
 from roverlab.msgs import MapMetaData, OccupancyGrid, array_to_occupancy_grid
 from roverlab.msgs import classes as mc
 from roverlab.tf import (
@@ -107,6 +107,7 @@ class SlamToolbox(Node):
         self.tf_listener = TransformListener(self.tf_buffer, self)
         self.tf_broadcaster = TransformBroadcaster(self)
         self.map_publisher = self.create_publisher(OccupancyGrid, "map", _LATCHED)
+        self.map_service = advertise_map_service(self, lambda: self.map_msg)
         self.metadata_publisher = self.create_publisher(MapMetaData, "map_metadata", _LATCHED)
         queue = int(node["scan_queue_size"])
         self.scan_filter = TfMessageFilter(

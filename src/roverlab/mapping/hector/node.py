@@ -22,12 +22,14 @@ What ROS 1's ``hector_mapping/hector_mapping`` (``HectorMappingRos``) does, with
 * publishes ``map`` and ``map_metadata`` (latched) every ``map_pub_period`` seconds when the
   map changed (hector publishes the finest level only);
 * ``sys_msg_topic`` (default ``syscommand``, ``std_msgs/String``): ``reset`` clears the map
-  and the pose.
+  and the pose;
+* ``advertise_map_service`` (default true): the ``dynamic_map`` service
+  (``nav_msgs/GetMap``) answers with the last published map.
 
 Parameters: the algorithm's (:class:`~roverlab.mapping.hector.HectorParams`: ROS names and
 defaults, plus roverlab's matcher options) and the node's above. ``pub_drawings``,
-``pub_debug_output``, ``advertise_map_service`` (no services in roverlab) and
-``output_timing`` are not implemented: a launch file that sets them gets a warning.
+``pub_debug_output`` and ``output_timing`` are not implemented: a launch file that sets
+them gets a warning.
 
 One deviation: the ``poseupdate`` covariance is the inverse of the matcher's Hessian (m,
 rad), a covariance; hector itself copies the Hessian there.
@@ -46,6 +48,7 @@ from roverlab.mapping.hector.errors import HectorInputError, OutOfMapError
 from roverlab.mapping.hector.params import HectorParams
 from roverlab.mapping.hector.slam import HectorSLAM
 from roverlab.mapping.laser import laser_geometry
+from roverlab.mapping.node_common import advertise_map_service
 from roverlab.msgs import (
     MapMetaData,
     OccupancyGrid,
@@ -88,6 +91,7 @@ NODE_DEFAULTS: dict[str, Any] = {
     "odom_frame": "odom",
     "tf_map_scanmatch_transform_frame_name": "scanmatcher_frame",
     "map_pub_period": 2.0,
+    "advertise_map_service": True,
 }
 
 
@@ -149,6 +153,8 @@ class HectorMapping(Node):
         self.tf_listener = TransformListener(self.tf_buffer, self)
         self.tf_broadcaster = TransformBroadcaster(self)
         self.map_publisher = self.create_publisher(OccupancyGrid, "map", _LATCHED)
+        if node["advertise_map_service"]:
+            self.map_service = advertise_map_service(self, lambda: self.map_msg)
         self.metadata_publisher = self.create_publisher(MapMetaData, "map_metadata", _LATCHED)
         self.pose_publisher = self.create_publisher(PoseStamped, "slam_out_pose", 1)
         self.pose_update_publisher = self.create_publisher(
