@@ -1,9 +1,10 @@
-"""amcl's compiled kernels: particle weighting, KLD resampling and clustering.
+"""amcl's compiled kernels: motion models, particle weighting, KLD resampling, clusters.
 
-Every kernel is ``numba.njit(cache=True, nogil=True)`` over plain arrays; random numbers
-come in as arrays drawn by the caller's ``np.random.Generator``, so a seeded run is
-reproducible. Map lookups work in cell units: a point ``(gx, gy)`` lies in cell
-``(int(gy), int(gx))`` when ``0 <= gx < width`` and ``0 <= gy < height``.
+Every kernel is ``numba.njit(cache=True, nogil=True)`` over plain arrays; kernels that
+draw take the caller's ``np.random.Generator`` (numba draws from its state, the same
+stream numpy would give), so a seeded run is reproducible. Map lookups work in cell
+units: a point ``(gx, gy)`` lies in cell ``(int(gy), int(gx))`` when ``0 <= gx < width``
+and ``0 <= gy < height``.
 
 The pose histogram (amcl's ``pf_kdtree``) has bins of 0.5 m x 0.5 m x 10 degrees; its
 key packs the three bin indices into one int64. Angles are wrapped to ``[-pi, pi)``, so
@@ -27,9 +28,11 @@ __all__ = [
     "BIN_XY_M",
     "beam_weights",
     "cluster_stats",
+    "diff_motion",
     "kld_resample",
     "likelihood_field_prob_weights",
     "likelihood_field_weights",
+    "omni_motion",
 ]
 
 _jit = numba.njit(cache=True, nogil=True)
@@ -273,42 +276,48 @@ def _hash_insert(table: I64, key: np.int64) -> bool:
 def kld_resample(
     poses: F64,
     weights: F64,
-    u0: float,
-    order_u: F64,
-    inject: NDArray[np.bool_],
-    random_poses: F64,
+    rng: np.random.Generator,
+    w_diff: float,
+    free_cells: I64,
+    resolution: float,
+    ox: float,
+    oy: float,
     limits: I64,
     out: F64,
     hash_table: I64,
-) -> int:
+) -> tuple[int, int]:
     """KLD-adaptive low-variance resampling with random-particle injection.
 
     A low-variance (systematic) sample of ``M = out.shape[0]`` draws is taken from the
-    weights (one uniform offset ``u0``); its draws are then visited in a random order
-    (a Fisher-Yates shuffle driven by ``order_u``), and the ``k``-th visited position is
-    replaced by the next of ``random_poses`` when ``inject[k]`` (amcl's
-    ``drand48() < w_diff``). Each sample's histogram bin is counted, and sampling stops
-    once the count exceeds ``limits[bins]`` (amcl's ``pf_resample_limit``) or reaches M.
-    Visiting the systematic sample in random order keeps its low variance while letting
-    the KLD rule stop at any count.
+    weights (one uniform offset); its draws are then visited in a random order (a lazy
+    Fisher-Yates shuffle), and each visited draw is replaced, with probability
+    ``w_diff``, by a random pose on a free cell (amcl's ``drand48() < w_diff``). Each
+    sample's histogram bin is counted, and sampling stops once the count exceeds
+    ``limits[bins]`` (amcl's ``pf_resample_limit``) or reaches M. Visiting the
+    systematic sample in random order keeps its low variance while letting the KLD rule
+    stop at any count (amcl falls back to independent draws, its comment says, because
+    the two do not combine easily).
 
     Args:
         poses: ``(N, 3)`` current particles.
         weights: ``(N,)`` their weights, normalised.
-        u0: uniform in ``[0, 1)``, the systematic offset.
-        order_u: ``(M,)`` uniforms in ``[0, 1)`` for the shuffle.
-        inject: ``(M,)`` which draws are random particles.
-        random_poses: ``(R, 3)`` random poses, ``R >= inject.sum()``.
+        rng: every draw.
+        w_diff: the injection probability.
+        free_cells: ``(K, 2)`` ``(row, col)`` of the map's free cells.
+        resolution: map cell side (m).
+        ox: map origin x (m).
+        oy: map origin y (m).
         limits: ``(M + 1,)`` the KLD sample bound for ``k`` occupied bins.
         out: ``(M, 3)`` receives the new particles.
         hash_table: work array, a power-of-two size above ``2 M``.
 
     Returns:
-        The number of new particles (the first rows of ``out``).
+        ``(new particle count (the first rows of out), random particles among them)``.
     """
     m = out.shape[0]
     n = poses.shape[0]
     idx = np.empty(m, dtype=np.int64)
+    u0 = rng.random()
     cum = 0.0
     i = 0
     for k in range(m):
@@ -319,20 +328,22 @@ def kld_resample(
         idx[k] = i
     hash_table[:] = -1
     bins = 0
-    used_random = 0
+    injected = 0
     count = 0
+    nfree = free_cells.shape[0]
     for k in range(m):
-        j = k + int(order_u[k] * (m - k))
+        j = k + int(rng.random() * (m - k))
         if j >= m:
             j = m - 1
         t = idx[k]
         idx[k] = idx[j]
         idx[j] = t
-        if inject[k]:
-            out[k, 0] = random_poses[used_random, 0]
-            out[k, 1] = random_poses[used_random, 1]
-            out[k, 2] = random_poses[used_random, 2]
-            used_random += 1
+        if w_diff > 0.0 and rng.random() < w_diff:
+            c = free_cells[min(int(rng.random() * nfree), nfree - 1)]
+            out[k, 0] = ox + (c[1] + rng.random()) * resolution
+            out[k, 1] = oy + (c[0] + rng.random()) * resolution
+            out[k, 2] = rng.random() * 2.0 * math.pi - math.pi
+            injected += 1
         else:
             src = idx[k]
             out[k, 0] = poses[src, 0]
@@ -343,7 +354,64 @@ def kld_resample(
         count = k + 1
         if count > limits[bins]:
             break
-    return count
+    return count, injected
+
+
+# ----------------------------------------------------------------------------- motion
+@_fast
+def diff_motion(
+    poses: F64,
+    rot1: float,
+    trans: float,
+    rot2: float,
+    sd_rot1: float,
+    sd_trans: float,
+    sd_rot2: float,
+    rng: np.random.Generator,
+) -> None:
+    """amcl's ``diff`` models per particle: rotate by ``rot1``, translate by ``trans``,
+    rotate by ``rot2``, each with a Gaussian of the given standard deviation; headings
+    are wrapped to ``[-pi, pi)``."""
+    for j in range(poses.shape[0]):
+        r1 = _wrap(rot1 - sd_rot1 * rng.standard_normal())
+        t = trans - sd_trans * rng.standard_normal()
+        r2 = _wrap(rot2 - sd_rot2 * rng.standard_normal())
+        th = poses[j, 2]
+        poses[j, 0] += t * math.cos(th + r1)
+        poses[j, 1] += t * math.sin(th + r1)
+        poses[j, 2] = _wrap(th + r1 + r2)
+
+
+@_fast
+def omni_motion(
+    poses: F64,
+    bearing: float,
+    trans: float,
+    rot: float,
+    sd_trans: float,
+    sd_rot: float,
+    sd_strafe: float,
+    rng: np.random.Generator,
+) -> None:
+    """amcl's ``omni`` models per particle: translate along ``bearing`` (relative to the
+    particle's heading) by ``trans`` with noise along and across (strafe), rotate by
+    ``rot``; headings are wrapped to ``[-pi, pi)``."""
+    for j in range(poses.shape[0]):
+        th = poses[j, 2]
+        b = bearing + th
+        cb = math.cos(b)
+        sb = math.sin(b)
+        t = trans + sd_trans * rng.standard_normal()
+        r = rot + sd_rot * rng.standard_normal()
+        st = sd_strafe * rng.standard_normal()
+        poses[j, 0] += t * cb + st * sb
+        poses[j, 1] += t * sb - st * cb
+        poses[j, 2] = _wrap(th + r)
+
+
+@_jit
+def _wrap(a: float) -> float:
+    return (a + math.pi) % (2.0 * math.pi) - math.pi
 
 
 @_jit

@@ -23,6 +23,7 @@ from numpy.typing import NDArray
 
 from roverlab.geometry import wrap_angle
 from roverlab.localization.amcl.errors import AmclParamsError
+from roverlab.localization.amcl.kernels import diff_motion, omni_motion
 from roverlab.localization.amcl.params import ODOM_MODELS
 
 __all__ = ["motion_noise_sigmas", "sample_motion"]
@@ -104,32 +105,17 @@ def sample_motion(
         delta: the odometry change ``(dx, dy, dtheta)`` in the odometry frame.
         old_theta: the odometry heading before the change (rad).
         alphas: ``odom_alpha1..5``.
-        rng: the random source (three standard normal draws per particle).
+        rng: the random source (three standard normal draws per particle, drawn in the
+            compiled kernel).
 
     Raises:
         AmclParamsError: an unknown model.
     """
     s0, s1, s2 = motion_noise_sigmas(model, delta, old_theta, alphas)
-    n = poses.shape[0]
-    noise = rng.standard_normal((3, n))
-    th = poses[:, 2]
     if model.startswith("diff"):
         rot1, trans, rot2 = _diff_terms(delta, old_theta)
-        rot1_hat = wrap_angle(rot1 - s0 * noise[0])
-        trans_hat = trans - s1 * noise[1]
-        rot2_hat = wrap_angle(rot2 - s2 * noise[2])
-        heading = th + rot1_hat
-        poses[:, 0] += trans_hat * np.cos(heading)
-        poses[:, 1] += trans_hat * np.sin(heading)
-        poses[:, 2] = wrap_angle(th + rot1_hat + rot2_hat)
+        diff_motion(poses, rot1, trans, rot2, s0, s1, s2, rng)
         return
     dx, dy, dth = delta
-    trans = math.hypot(dx, dy)
-    bearing = float(wrap_angle(math.atan2(dy, dx) - old_theta)) + th
-    cb, sb = np.cos(bearing), np.sin(bearing)
-    trans_hat = trans + s0 * noise[0]
-    rot_hat = dth + s1 * noise[1]
-    strafe_hat = s2 * noise[2]
-    poses[:, 0] += trans_hat * cb + strafe_hat * sb
-    poses[:, 1] += trans_hat * sb - strafe_hat * cb
-    poses[:, 2] = wrap_angle(th + rot_hat)
+    bearing = float(wrap_angle(math.atan2(dy, dx) - old_theta))
+    omni_motion(poses, bearing, math.hypot(dx, dy), dth, s0, s1, s2, rng)

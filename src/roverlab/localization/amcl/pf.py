@@ -27,6 +27,17 @@ FloatArray = NDArray[np.float64]
 CONVERGED_DISTANCE_M = 0.5
 
 
+def _average(current: float, sample: float, alpha: float, count: int) -> float:
+    """One step of a bias-corrected exponential average (``alpha`` 0: frozen at the first
+    sample, as amcl with a zero rate)."""
+    if current == 0.0 or count <= 1:
+        return sample
+    if alpha <= 0.0:
+        return current
+    rate = max(alpha, 1.0 / count)
+    return current + rate * (sample - current)
+
+
 def kld_limits(
     max_particles: int, min_particles: int, kld_err: float, kld_z: float
 ) -> NDArray[np.int64]:
@@ -136,6 +147,7 @@ class ParticleFilter:
         self.n_effective = 1.0
         self.converged = False
         self.injected = 0
+        self._samples = 0
         self._clusters: Clusters | None = None
         self.init_uniform()
 
@@ -145,6 +157,7 @@ class ParticleFilter:
         n = self.poses.shape[0]
         self.weights = np.full(n, 1.0 / n)
         self.w_slow = self.w_fast = 0.0
+        self._samples = 0
         self.n_effective = float(n)
         self.converged = False
         self.injected = 0
@@ -209,9 +222,14 @@ class ParticleFilter:
         """After a sensor kernel multiplied the weights (their sum is ``total``):
         normalise, update the effective sample size and the likelihood averages.
 
-        The averages follow Probabilistic Robotics' Augmented MCL: the mean measurement
-        likelihood ``sum(w_before * p)`` (``w_before`` summing to one). A zero or
-        non-finite total makes the weights uniform and leaves the averages alone.
+        The averages follow Probabilistic Robotics' Augmented MCL over the mean measurement
+        likelihood ``sum(w_before * p)`` (``w_before`` summing to one; amcl divides it by
+        the particle count as well, which makes it jump whenever KLD sampling changes the
+        count). They are bias-corrected exponential averages: the plain mean of the
+        samples so far until there are ``1 / alpha`` of them (amcl starts them at the first
+        sample, so with ``alpha_slow`` 0.001 ``w_slow`` remembers the start-up for many
+        minutes). A zero or non-finite total makes the weights uniform and leaves the
+        averages alone.
         """
         self._clusters = None
         n = self.count
@@ -222,51 +240,43 @@ class ParticleFilter:
         w_avg = total
         self.weights /= total
         self.n_effective = 1.0 / float(np.dot(self.weights, self.weights))
-        if self.w_slow == 0.0:
-            self.w_slow = w_avg
-        else:
-            self.w_slow += self.alpha_slow * (w_avg - self.w_slow)
-        if self.w_fast == 0.0:
-            self.w_fast = w_avg
-        else:
-            self.w_fast += self.alpha_fast * (w_avg - self.w_fast)
+        self._samples += 1
+        self.w_slow = _average(self.w_slow, w_avg, self.alpha_slow, self._samples)
+        self.w_fast = _average(self.w_fast, w_avg, self.alpha_fast, self._samples)
 
     # ------------------------------------------------------------------ resampling
     def resample(self) -> None:
         """amcl's ``pf_update_resample``: KLD-adaptive resampling, each draw replaced by a
-        random particle with probability ``max(0, 1 - w_fast / w_slow)`` (the averages are
-        then reset); with ``selective_resampling`` nothing is drawn while the effective
-        sample size is at least half the particles."""
+        random particle with probability ``max(0, 1 - w_fast / w_slow)``; with
+        ``selective_resampling`` nothing is drawn while the effective sample size is at
+        least half the particles.
+
+        amcl resets both averages after injecting, so that while the robot stays lost
+        they restart at the lost level and injection stops after one burst; here they
+        keep running, and injection goes on (at most ``1 - p_random / w_slow`` of the
+        draws) until the particles explain the scans as well as ``w_slow`` remembers.
+        """
         if self.selective_resampling and self.n_effective > 0.5 * self.count:
             self._clusters = None
             self._update_converged()
             return
-        m = self.max_particles
         w_diff = 0.0
         if self.w_slow > 0.0:
             w_diff = max(0.0, 1.0 - self.w_fast / self.w_slow)
-        u0 = float(self.rng.random())
-        order_u = self.rng.random(m)
-        if w_diff > 0.0:
-            inject = self.rng.random(m) < w_diff
-            random_poses = self.random_poses(int(inject.sum()))
-        else:
-            inject = np.zeros(m, dtype=np.bool_)
-            random_poses = np.zeros((0, 3))
-        n = kld_resample(
+        ox, oy = self.map.origin_xy
+        n, self.injected = kld_resample(
             self.poses,
             self.weights,
-            u0,
-            order_u,
-            inject,
-            random_poses,
+            self.rng,
+            w_diff,
+            self.map.free_cells,
+            self.map.resolution_m,
+            ox,
+            oy,
             self._limits,
             self._out,
             self._hash,
         )
-        self.injected = int(inject[:n].sum())
-        if w_diff > 0.0:
-            self.w_slow = self.w_fast = 0.0
         self.poses = self._out[:n].copy()
         self.weights = np.full(n, 1.0 / n)
         self._clusters = None
