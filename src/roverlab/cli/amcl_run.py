@@ -28,6 +28,7 @@ from roverlab.geometry import SE2
 from roverlab.localization.amcl import (
     Amcl,
     AmclError,
+    AmclMapError,
     AmclParams,
     AmclRun,
     localize_log,
@@ -160,7 +161,10 @@ def run(
     raw = parse_params(param, AmclError)
     params = AmclParams.from_ros(raw)
     occupancy = load_map(map_yaml)
-    amcl_map = map_for_amcl(occupancy, params)
+    try:
+        amcl_map = map_for_amcl(occupancy, params)
+    except AmclMapError as err:
+        raise AmclMapError(f"{map_yaml}: {err}") from err
     if global_start:
         pose, source = None, "--global"
     else:

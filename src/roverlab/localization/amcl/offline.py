@@ -36,9 +36,7 @@ def map_for_amcl(occupancy: OccupancyMap, params: AmclParams) -> AmclMap:
     """
     ox, oy, yaw = occupancy.info.origin
     if abs(yaw) > 1e-9:
-        raise AmclMapError(
-            f"{occupancy.info.image}: the map origin is rotated (yaw {yaw}); amcl needs yaw 0"
-        )
+        raise AmclMapError(f"the map origin is rotated (yaw {yaw}); amcl needs yaw 0")
     return AmclMap(
         data=occupancy.data,
         resolution_m=occupancy.info.resolution,
