@@ -26,7 +26,7 @@ def maze_maps(tmp_path_factory: pytest.TempPathFactory) -> dict[str, tuple[Path,
 
 def _check_tracking(d: Drive, name: str) -> None:
     med, p95, yaw = d.stats(after=5.0)
-    print(f"\n{name}: median {100 * med:.1f} cm, p95 {100 * p95:.1f} cm, yaw {yaw:.2f} deg, "
+    print(f"\n{name}: median {100 * med:.2f} cm, p95 {100 * p95:.2f} cm, yaw {yaw:.2f} deg, "
           f"{d.wall_s:.1f} s wall")  # fmt: skip
     assert med <= 0.03 and p95 <= 0.08 and yaw <= 1.0
 
