@@ -9,6 +9,7 @@ import typer
 
 from roverlab.cli import (
     action,
+    amcl_run,
     daemon,
     demo,
     graph,
@@ -57,6 +58,7 @@ slam_cli.app.command("run")(slam_run.run)
 slam_cli.app.command("mapeval")(slam_mapeval.mapeval)
 app.add_typer(slam_cli.app, name="slam")
 app.command("teleop")(teleop_cli.teleop)
+app.add_typer(amcl_run.app, name="amcl")
 
 
 @app.callback()

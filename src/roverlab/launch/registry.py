@@ -20,6 +20,7 @@ from roverlab.description.node import JointStatePublisher, RobotStatePublisher
 from roverlab.errors import RoverlabError
 from roverlab.geometry import quat_from_rpy
 from roverlab.launch.xml import LaunchError, NodeSpec
+from roverlab.localization.amcl.node import AmclNode
 from roverlab.mapping.gmapping.node import SlamGMapping
 from roverlab.mapping.graph.node import SlamKarto, SlamToolbox
 from roverlab.mapping.hector.node import HectorMapping
@@ -286,6 +287,7 @@ REGISTRY[("hector_mapping", "hector_mapping")] = _slam_node(HectorMapping)
 REGISTRY[("slam_toolbox", "async_slam_toolbox_node")] = _slam_node(SlamToolbox)
 REGISTRY[("slam_toolbox", "sync_slam_toolbox_node")] = _slam_node(SlamToolbox)
 REGISTRY[("slam_karto", "slam_karto")] = _slam_node(SlamKarto)
+REGISTRY[("amcl", "amcl")] = _slam_node(AmclNode)
 
 
 def _unavailable(reason: str) -> NodeFactory:
