@@ -36,6 +36,7 @@ import numpy as np
 import scipy.sparse as sp
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import least_squares
+from threadpoolctl import ThreadpoolController
 
 from roverlab.geometry import SE2, wrap_angle
 from roverlab.navigation.controllers.base import Velocity2D, angle_diff, as_plan, stopped
@@ -54,6 +55,9 @@ from roverlab.navigation.errors import InvalidPathError, NoValidControlError
 __all__ = ["TebPlanner"]
 
 _DT_MIN = 1e-3  # floor of every time difference after a solve
+# MINPACK's QR goes through LAPACK: on one BLAS thread it is faster for these small
+# matrices, never stalls on a busy machine, and gives the same bits every run
+_BLAS = ThreadpoolController()
 # typical size of a step in x, y (m), theta (rad) and dt (s): the solver's variable scale
 _SCALE = np.array([0.1, 0.1, 0.2, 0.1])
 
@@ -522,7 +526,8 @@ class TebPlanner:
                 p.min_samples, p.allow_init_with_backwards_motion,
             )  # fmt: skip
         try:
-            self._optimize(twist, p.free_goal_vel)
+            with _BLAS.limit(limits=1, user_api="blas"):
+                self._optimize(twist, p.free_goal_vel)
         except (ValueError, np.linalg.LinAlgError) as err:
             band.clear()
             raise NoValidControlError(
