@@ -13,8 +13,8 @@ from roverlab.navigation.controllers.teb import TimedElasticBand
 from roverlab.navigation.controllers.teb.kernels import robot_distance
 from roverlab.navigation.costmap import Costmap2D, footprint_from_radius
 from roverlab.navigation.errors import NavigationParamsError, NoValidControlError
-from tests.navigation.controllers.conftest import TEB
 from roverlab.navigation.planners import NavfnPlanner
+from tests.navigation.controllers.conftest import TEB
 from tests.navigation.controllers.sim import ROBOT_RADIUS, costmaps, field_world, run
 
 FOOT = footprint_from_radius(ROBOT_RADIUS)
