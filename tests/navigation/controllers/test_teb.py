@@ -52,7 +52,13 @@ def test_footprint_model_parameters() -> None:
         {"type": "polygon", "vertices": [[0.1, 0.1], [-0.1, 0.1], [0, -0.1]]}
     )
     assert m.code == 4 and len(m.values) == 6
-    p, _ = TebParams.from_ros({"footprint_model/type": "line", "footprint_model/line_start": [-0.1, 0.0], "footprint_model/line_end": [0.1, 0.0]})  # fmt: skip
+    p, _ = TebParams.from_ros(
+        {
+            "footprint_model/type": "line",
+            "footprint_model/line_start": [-0.1, 0.0],
+            "footprint_model/line_end": [0.1, 0.0],
+        }
+    )
     assert p.footprint_model == FootprintModel("line", (-0.1, 0.0, 0.1, 0.0))
     with pytest.raises(NavigationParamsError, match="radius is required"):
         FootprintModel.from_ros({"type": "circular"})
@@ -124,7 +130,9 @@ def test_teb_reaches_the_goal_through_a_cluttered_field(teb_params: TebParams, s
 
 
 def test_move_forward_only(teb_params: TebParams) -> None:
-    p = TebParams.from_ros({**TEB, "max_vel_x_backwards": 0.01, "weight_kinematics_forward_drive": 1000})[0]  # fmt: skip
+    p = TebParams.from_ros(
+        {**TEB, "max_vel_x_backwards": 0.01, "weight_kinematics_forward_drive": 1000}
+    )[0]
     r = run(TebPlanner(p, footprint=FOOT), field_world(1), SE2(1, 1, math.pi), SE2(2.5, 1.5, 0.0))
     assert r.reached and not r.collided
     assert min(c.vx for c in r.commands) >= -0.01 - 1e-9
