@@ -17,10 +17,10 @@ Per control cycle, as TebLocalPlannerROS::computeVelocityCommands:
   ``force_reinit_new_goal_dist`` / ``_angular``), then ``no_outer_iterations`` times:
   resized (``teb_autosize``, ``dt_ref``, ``dt_hysteresis``), obstacles associated to poses,
   and optimised as a nonlinear least-squares problem by Levenberg-Marquardt (TEB runs g2o's
-  LM for ``no_inner_iterations`` iterations; here scipy's ``least_squares(method="lm")``,
-  MINPACK, with ``2 * no_inner_iterations`` evaluations, the edges' sparse Jacobian
-  assembled by the compiled kernel); the obstacle weight grows by ``weight_adapt_factor``
-  each time;
+  LM for ``no_inner_iterations`` iterations; here MINPACK's ``lmder`` through scipy's
+  ``leastsq``, the same routine as ``least_squares(method="lm")`` with less overhead, with
+  ``no_inner_iterations + 2`` cost evaluations, the Jacobian assembled by the compiled
+  kernel); the obstacle weight grows by ``weight_adapt_factor`` each time;
 * the first ``feasibility_check_no_poses`` poses are checked against the costmap with the
   costmap's footprint; the command is the velocity between the first pose and the next
   (``control_look_ahead_poses``), saturated to the limits.
@@ -31,11 +31,11 @@ Failures raise :class:`NoValidControlError` and reset the band, as TEB clears it
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
-import scipy.sparse as sp
 from numpy.typing import ArrayLike, NDArray
-from scipy.optimize import least_squares
+from scipy.optimize import leastsq
 from threadpoolctl import ThreadpoolController
 
 from roverlab.geometry import SE2, wrap_angle
@@ -45,6 +45,7 @@ from roverlab.navigation.controllers.teb.kernels import (
     associate_obstacles,
     build_structure,
     evaluate,
+    scatter_transposed,
 )
 from roverlab.navigation.controllers.teb.params import TebParams
 from roverlab.navigation.costmap.costmap_2d import LETHAL_OBSTACLE, Costmap2D
@@ -155,7 +156,6 @@ class TebPlanner:
         self._last_pose: SE2 | None = None
         self._last_twist = Velocity2D()
         self._line_buf = np.empty((4096, 2), dtype=np.int64)
-        self.iterations = 0
 
     # ------------------------------------------------------------------ plan / goal
     def set_plan(self, plan: ArrayLike) -> None:
@@ -334,7 +334,6 @@ class TebPlanner:
         fm = p.footprint_model
         model, mp = fm.code, fm.as_array()
         mult = 1.0
-        self.iterations = 0
         for _ in range(p.no_outer_iterations):
             if p.teb_autosize:
                 self.band.auto_resize(p.dt_ref, p.dt_hysteresis, p.min_samples, p.max_samples)
@@ -355,17 +354,22 @@ class TebPlanner:
                 evaluate(x0 + d, poses, dts, et, pi, di, ax, sw, cfg, model, mp, False, r, jdata)  # noqa: B023
                 return r.copy()  # noqa: B023
 
+            jt = np.zeros((nvar, nres))
+
             def jac(d: NDArray[np.float64]) -> NDArray[np.float64]:
                 evaluate(x0 + d, poses, dts, et, pi, di, ax, sw, cfg, model, mp, True, r, jdata)  # noqa: B023
-                return sp.csr_matrix((jdata, indices, indptr), shape=(nres, nvar)).toarray()  # noqa: B023
+                scatter_transposed(jdata, indices, indptr, jt)  # noqa: B023
+                return jt  # noqa: B023
 
             scale = np.concatenate([np.tile(_SCALE[:3], n - 2), np.full(n - 1, _SCALE[3])])
-            res = least_squares(
-                fun, np.zeros(nvar), jac=jac, method="lm" if nres >= nvar else "trf",
-                max_nfev=p.no_inner_iterations + 2, x_scale=scale,
-            )  # fmt: skip
-            self.iterations += int(res.nfev)
-            x = x0 + res.x
+            with warnings.catch_warnings():
+                # leastsq warns when it stops at maxfev: that is the iteration budget
+                warnings.simplefilter("ignore", RuntimeWarning)
+                sol, _ier = leastsq(
+                    fun, np.zeros(nvar), Dfun=jac, col_deriv=True,
+                    maxfev=p.no_inner_iterations + 2, diag=1.0 / scale,
+                )  # fmt: skip
+            x = x0 + np.asarray(sol, dtype=np.float64)
             self.band.poses[1:-1] = x[: 3 * (n - 2)].reshape(-1, 3)
             self.band.poses[1:-1, 2] = wrap_angle(self.band.poses[1:-1, 2])
             # g2o bounds no variable either; a time difference must stay positive
@@ -528,7 +532,7 @@ class TebPlanner:
         try:
             with _BLAS.limit(limits=1, user_api="blas"):
                 self._optimize(twist, p.free_goal_vel)
-        except (ValueError, np.linalg.LinAlgError) as err:
+        except (ValueError, TypeError, np.linalg.LinAlgError) as err:
             band.clear()
             raise NoValidControlError(
                 f"teb_local_planner was not able to obtain a local plan ({err})"
