@@ -9,8 +9,8 @@ Figures, one per line, median and p99 of the per-call wall time:
 - costmap update: a 720-beam, 12 m laser scan (cast in the maze by the shared ray
   caster) into a 10 m x 10 m rolling window at 0.05 m (obstacle layer marking and
   clearing, inflation 0.5 m), along a drive through the maze;
-- navfn and global_planner ``plan`` between seeded random free cells (>= 2 m apart) of the
-  maze and the office, global costmap static + inflation;
+- navfn and global_planner ``plan`` between seeded random free cells (>= 2 m apart,
+  connected to the spawn) of the maze and the office, global costmap static + inflation;
 - DWA and TEB ``compute_velocity`` in closed loop (a unicycle with acceleration limits)
   over seeded goals in the maze, 3 m rolling local costmap; targets p99 <= 10 ms (DWA)
   and <= 25 ms (TEB) on one core; success and collisions are printed too.
@@ -26,6 +26,7 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
+from scipy import ndimage
 
 from roverlab.geometry import SE2
 from roverlab.navigation.controllers import (
@@ -86,8 +87,12 @@ def layered(
 
 
 def free_cells(lc: LayeredCostmap, rng: np.random.Generator, n: int) -> list[SE2]:
+    """``n`` random poses on zero-cost cells connected to the spawn (0, 0)."""
     cm = lc.costmap
-    ys, xs = np.nonzero(cm.costs == 0)
+    labels, _ = ndimage.label(cm.costs == 0)
+    spawn = cm.world_to_map(0.0, 0.0)
+    assert spawn is not None
+    ys, xs = np.nonzero(labels == labels[spawn[1], spawn[0]])
     out = []
     while len(out) < n:
         k = int(rng.integers(len(xs)))
@@ -130,8 +135,10 @@ def bench_costmap(seed: int) -> None:
         ranges = cast_2d(scene, pose.x, pose.y, 0.1, angles + pose.theta, 12.0)
         keep = np.isfinite(ranges) & (ranges < 12.0)
         r = np.where(keep, ranges, 12.0 - 1e-4)
-        pts = np.column_stack([pose.x + r * np.cos(angles + pose.theta),
-                               pose.y + r * np.sin(angles + pose.theta), np.full(len(r), 0.1)])  # fmt: skip
+        a = angles + pose.theta
+        pts = np.column_stack(
+            [pose.x + r * np.cos(a), pose.y + r * np.sin(a), np.full(len(r), 0.1)]
+        )
         t0 = time.perf_counter()
         obstacle.add_observation("scan", [pose.x, pose.y, 0.1], pts, k * 0.1, k * 0.1)  # type: ignore[attr-defined]
         lc.update_map(pose.x, pose.y, pose.theta, k * 0.1)
