@@ -24,8 +24,8 @@ from roverlab.mapping.gmapping.node import SlamGMapping
 from roverlab.mapping.graph.node import SlamKarto, SlamToolbox
 from roverlab.mapping.hector.node import HectorMapping
 from roverlab.maps.node import MapSaver, MapServer
-from roverlab.navigation.costmap.node import Costmap2DNode
 from roverlab.msgs import classes as mc
+from roverlab.navigation.costmap.node import Costmap2DNode
 from roverlab.viz.errors import DashboardError
 from roverlab.viz.launcher import start_rviz
 from roverlab.world import BUNDLED_WORLDS, load_world

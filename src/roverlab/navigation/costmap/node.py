@@ -46,11 +46,11 @@ _SENSOR_QUEUE = 50
 def _host_parameters(node: Node, name: str) -> dict[str, Any]:
     """Every override of ``node`` under ``name/`` (declared now, so none is reported as
     unused), plus the host-level ``footprint`` / ``robot_radius`` (ROS's searchParam)."""
-    prefix = name + "/"
     values: dict[str, Any] = {}
     for key in node.unused_parameter_overrides():
-        if key.startswith(prefix):
-            values[key[len(prefix) :]] = node.declare_parameter(key, None).value
+        for prefix in (name + "/", name + "."):  # rosparam (ROS 1) or YAML (ROS 2) names
+            if key.startswith(prefix):
+                values[key[len(prefix) :]] = node.declare_parameter(key, None).value
     for key in ("footprint", "robot_radius", "footprint_padding"):
         if key not in values:
             if node.has_parameter(key):

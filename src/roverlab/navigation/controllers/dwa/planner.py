@@ -350,10 +350,10 @@ class DWAPlanner:
         if self._orig_plan is None or not np.array_equal(new, self._orig_plan):
             self.set_plan(new)
         self._last_pose, self._last_twist = pose, twist
-        if p.prune_plan:
+        if p.prune_plan and len(self._plan):
+            # base_local_planner's prunePlan: with no point within 1 m the plan is used up
+            # (until the next setPlan), as in ROS
             self._plan = prune_plan(pose, self._plan)
-            if len(self._plan) == 0:
-                self._plan = self._orig_plan[-1:] if self._orig_plan is not None else self._plan
         local = local_plan_window(pose, self._plan, costmap)
         if len(local) == 0:
             raise InvalidPathError("dwa_local_planner: received an empty transformed plan")
