@@ -25,6 +25,7 @@ from PIL import Image
 
 from roverlab.core import Context, QoSProfile, Time
 from roverlab.geometry import Transform3
+from roverlab.localization.amcl.node import AmclNode
 from roverlab.msgs import (
     Marker,
     MarkerArray,
@@ -68,6 +69,7 @@ class Live:
     ctx: Context
     sim: Simulation
     server: DashboardServer
+    amcl: AmclNode
     grid: np.ndarray
     origin: tuple[float, float]
     robot: tuple[float, float]
@@ -99,6 +101,9 @@ def _extra_displays() -> list[DisplayConfig]:
         DisplayConfig("point_cloud2", "Cloud", True, "/test/cloud", {"size_px": 4.0}),
         DisplayConfig("marker_array", "Markers", True, "/test/markers", {}),
         DisplayConfig("pose_array", "Lost", True, "/test/lost", {}),
+        DisplayConfig(
+            "pose_with_covariance", "AMCL pose", True, "/test/amcl_pose", {"color": [255, 255, 0]}
+        ),
         DisplayConfig("path", "Silent", True, "/test/silent", {}),
     ]
 
@@ -108,6 +113,9 @@ def _publishers(live_node: Any, robot: tuple[float, float]) -> None:
     plan_pub = live_node.create_publisher("nav_msgs/msg/Path", "/test/plan", 1)
     parts_pub = live_node.create_publisher("geometry_msgs/msg/PoseArray", "/test/particles", 1)
     lost_pub = live_node.create_publisher("geometry_msgs/msg/PoseArray", "/test/lost", 1)
+    amcl_pub = live_node.create_publisher(
+        "geometry_msgs/msg/PoseWithCovarianceStamped", "/test/amcl_pose", 1
+    )
     live_node.create_publisher("nav_msgs/msg/Path", "/test/silent", 1)  # never publishes
     cloud_pub = live_node.create_publisher("sensor_msgs/msg/PointCloud2", "/test/cloud", 1)
     marker_pub = live_node.create_publisher(
@@ -128,6 +136,13 @@ def _publishers(live_node: Any, robot: tuple[float, float]) -> None:
         poses=[pose_from_xytheta(rx - 2.5 + 0.5 * i, ry - 2.0, math.pi / 2) for i in range(3)],
     )
     lost = PoseArray(header={"frame_id": "nowhere"}, poses=[pose_from_xytheta(0, 0, 0)])
+    cov = np.zeros(36)
+    cov[0], cov[7], cov[35] = 0.4**2, 0.15**2, 0.2**2  # 1-sigma ellipse 0.8 m x 0.3 m
+    amcl_pose = make(
+        "geometry_msgs/msg/PoseWithCovarianceStamped",
+        header=header,
+        pose={"pose": pose_from_xytheta(rx + 1.0, ry - 1.0, 0.0), "covariance": cov},
+    )
     gx, gy = np.meshgrid(np.linspace(0, 0.8, 12), np.linspace(0, 0.8, 12))
     zs = np.linspace(0.0, 1.0, gx.size)
     cloud_pts = np.column_stack((gx.ravel() + rx + 2.0, gy.ravel() + ry - 2.4, zs))
@@ -159,6 +174,7 @@ def _publishers(live_node: Any, robot: tuple[float, float]) -> None:
         plan_pub.publish(plan)
         parts_pub.publish(parts)
         lost_pub.publish(lost)
+        amcl_pub.publish(amcl_pose)
         cloud_pub.publish(cloud)
         marker_pub.publish(MarkerArray(markers=[cube, text]))
         depth_pub.publish(depth_msg)
@@ -198,6 +214,9 @@ def live(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Live]:
         "geometry_msgs/msg/PointStamped", "/clicked_point", got["point"].append, 10
     )
     node.create_subscription("nav_msgs/msg/Odometry", "/odom", got["odom"].append, 10)
+    # amcl on the published map, re-initialised by 2D Pose Estimate (the test node's
+    # static map -> odom stays the only one)
+    amcl = AmclNode(ctx, parameter_overrides={"use_map_topic": True, "tf_broadcast": False})
     config = default_config("map")
     config.displays += _extra_displays()
     map_dir = tmp_path_factory.mktemp("maps")
@@ -206,7 +225,9 @@ def live(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Live]:
     )
     ctx.spin_in_thread()
     server.start()
-    yield Live(ctx, sim, server, grid, (float(origin[0]), float(origin[1])), robot, map_dir, got)
+    yield Live(
+        ctx, sim, server, amcl, grid, (float(origin[0]), float(origin[1])), robot, map_dir, got
+    )
     server.stop()
     ctx.shutdown()
 
@@ -324,6 +345,14 @@ def test_path_poses_cloud_and_markers_are_drawn(live: Live, page: Any, tmp_path:
     assert _count(_near(img, v, rx - 2.5, ry, 10), (255, 128, 0), tol=30) > 100, "no cube"
     # the text marker: white pixels around its anchor
     assert _count(_near(img, v, rx + 2.5, ry + 0.5, 14), (255, 255, 255), tol=30) > 10
+    # the amcl pose: a yellow arrow, its 1-sigma ellipse outlined 0.4 m to either side
+    # along x and 0.15 m along y, filled faintly inside
+    assert _count(_near(img, v, rx + 1.5, ry - 1.0, 3), (255, 255, 0)) > 3, "no arrow"
+    for dx, dy in ((-0.4, 0.0), (0.0, 0.15), (0.0, -0.15)):
+        edge = _near(img, v, rx + 1.0 + dx, ry - 1.0 + dy, 2)
+        assert _count(edge, (255, 255, 0), tol=60) > 0, f"no ellipse at {dx}, {dy}"
+    outside = _near(img, v, rx + 1.0, ry - 1.0 + 0.3, 2)
+    assert _count(outside, (255, 255, 0), tol=60) == 0
 
 
 @browser_only
@@ -384,6 +413,14 @@ def test_pose_estimate_tool_publishes_initialpose(live: Live, page: Any) -> None
     assert abs(yaw - math.atan2(-40, -80)) < 0.05
     cov = np.asarray(msg.pose.covariance)
     assert cov[0] == 0.25 and cov[7] == 0.25 and cov[35] == 0.06853891945200942
+
+    # amcl takes it: its particles are re-drawn around the clicked pose
+    def around() -> bool:
+        assert live.amcl.amcl is not None
+        p = live.amcl.amcl.pf.poses
+        return bool(math.hypot(p[:, 0].mean() - wx, p[:, 1].mean() - wy) < 0.1)
+
+    assert _wait(around), "amcl did not re-initialise at the 2D Pose Estimate"
 
 
 @browser_only

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 
 from roverlab.geometry import Transform3, quat_from_rpy, quat_from_yaw
 from roverlab.msgs import Marker, pose_from_xytheta
@@ -15,6 +16,7 @@ from roverlab.viz.displays import (
     decimate,
     map_change,
     marker_primitives,
+    pose_covariance_primitives,
     poses_in_fixed,
 )
 
@@ -140,3 +142,27 @@ def test_colour_buckets_and_decimation() -> None:
     assert pal[0, :3].tolist() == [255, 0, 255] and pal[-1, :3].tolist() == [255, 0, 0]
     pts = np.arange(100_000).reshape(-1, 2)
     assert len(decimate(pts, 20_000)) <= 20_000 and len(decimate(pts, 0)) == 50_000
+
+
+def test_pose_covariance_primitives_draw_the_sigma_ellipse_and_yaw_wedge() -> None:
+    c, s = math.cos(0.5), math.sin(0.5)
+    rot = np.array([[c, -s], [s, c]])
+    cov = rot @ np.diag([0.3**2, 0.1**2]) @ rot.T  # 0.3 m along 0.5 rad, 0.1 m across
+    items = pose_covariance_primitives((1.0, 2.0, 0.2), cov, 0.1**2, rgb=[255, 0, 0],
+                                       alpha=0.9, length=1.0, scale=2.0)  # fmt: skip
+    ellipse, outline, wedge, arrow = items
+    assert [i["shape"] for i in items] == ["polygon", "polyline", "polygon", "arrow"]
+    pts = np.array(ellipse["points"]) - (1.0, 2.0)
+    local = pts @ rot  # into the ellipse's axes
+    assert np.abs(local[:, 0]).max() == pytest.approx(0.6, abs=1e-3)  # 2 sigma
+    assert np.abs(local[:, 1]).max() == pytest.approx(0.2, abs=2e-3)
+    assert outline["points"][0] == outline["points"][-1]
+    assert ellipse["rgba"] == [1.0, 0.0, 0.0, 0.3] and arrow["rgba"] == [1.0, 0.0, 0.0, 0.9]
+    angles = np.arctan2(*(np.array(wedge["points"][1:]) - (1.0, 2.0)).T[::-1])
+    assert angles.min() == pytest.approx(0.0, abs=1e-3)  # yaw 0.2 -+ 2 sigma (0.1)
+    assert angles.max() == pytest.approx(0.4, abs=1e-3)
+    assert arrow["yaw"] == 0.2 and arrow["points"] == [[1.0, 2.0]]
+    # no covariance (NaN) or no yaw variance: just the arrow
+    only = pose_covariance_primitives((0, 0, 0), np.full((2, 2), np.nan), 0.0, rgb=[0, 0, 0],
+                                      alpha=1.0, length=1.0)  # fmt: skip
+    assert [i["shape"] for i in only] == ["arrow"]

@@ -9,10 +9,12 @@ import typer
 
 from roverlab.cli import (
     action,
+    amcl_run,
     daemon,
     demo,
     graph,
     launch,
+    run,
     service,
     sim,
     slam_mapeval,
@@ -45,6 +47,10 @@ app.add_typer(daemon.app, name="daemon")
 app.command("demo")(demo.demo)
 app.command("sim")(sim.sim)
 app.command("launch")(launch.launch)
+app.command(
+    "run",
+    context_settings={"allow_extra_args": True, "ignore_unknown_options": True},
+)(run.run)
 app.command("dashboard")(viz_cli.dashboard)
 app.add_typer(urdf_cli.app, name="urdf")
 app.add_typer(map_cli.app, name="map")
@@ -52,6 +58,7 @@ slam_cli.app.command("run")(slam_run.run)
 slam_cli.app.command("mapeval")(slam_mapeval.mapeval)
 app.add_typer(slam_cli.app, name="slam")
 app.command("teleop")(teleop_cli.teleop)
+app.add_typer(amcl_run.app, name="amcl")
 
 
 @app.callback()

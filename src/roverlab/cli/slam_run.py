@@ -4,30 +4,32 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Iterator
 from pathlib import Path
 from typing import Annotated, NamedTuple
 
 import numpy as np
 import typer
-import yaml
 from PIL import Image, ImageDraw
-from rich.console import Console
-from rich.progress import (
-    BarColumn,
-    MofNCompleteColumn,
-    Progress,
-    TextColumn,
-    TimeElapsedColumn,
-    TimeRemainingColumn,
-)
 
+from roverlab.cli.log_input import (
+    BaseFrameOption,
+    FirstOption,
+    LogArgument,
+    OdomFrameOption,
+    OdomTopicOption,
+    ParamOption,
+    ScanTopicOption,
+    TfTopicOption,
+    parse_params,
+    progress,
+    read_log,
+)
 from roverlab.mapping.gmapping import GMapping, GMappingParams
 from roverlab.mapping.graph import GraphParams, GraphSLAM
 from roverlab.mapping.hector import HectorParams, HectorSLAM
 from roverlab.maps import save_map
 from roverlab.slam.errors import SlamError
-from roverlab.slam.logs import LaserLog, ScanRecord, load_log
+from roverlab.slam.logs import LaserLog
 from roverlab.slam.trajectory import Trajectory, write_tum
 
 METHODS = ("hector", "gmapping", "graph")
@@ -37,27 +39,9 @@ _HECTOR_MARGIN_M = 5.0
 _HECTOR_MARGIN_SHARE = 0.15
 
 
-def _progress(records: LaserLog, label: str) -> Iterator[ScanRecord]:
-    """The records, with a progress bar on stderr (refreshed only on a terminal)."""
-    console = Console(stderr=True)
-    if not console.is_terminal:
-        yield from records
-        return
-    with Progress(
-        TextColumn(label), BarColumn(), MofNCompleteColumn(), TextColumn("scans"),
-        TimeElapsedColumn(), TextColumn("<"), TimeRemainingColumn(), console=console,
-        transient=True,
-    ) as bar:  # fmt: skip
-        task = bar.add_task(label, total=len(records))
-        for i, rec in enumerate(records):
-            yield rec
-            if i % 50 == 49:
-                bar.update(task, completed=i + 1)
-
-
 def run_graph(records: LaserLog, params: dict[str, object]) -> MethodResult:
     slam = GraphSLAM(GraphParams.from_ros(params))
-    result = slam.run_log(_progress(records, "graph"))
+    result = slam.run_log(progress(records, "graph"))
     m = result.map
     g = slam.graph()
     notes = [f"graph: {g.num_vertices} keyframes, {g.num_edges} constraints"]
@@ -115,7 +99,7 @@ def run_hector(records: LaserLog, params: dict[str, object]) -> MethodResult:
             f"({hp.map_size * hp.map_resolution:.1f} m), map_start_x {hp.map_start_x:.3f}, "
             f"map_start_y {hp.map_start_y:.3f}"
         )
-    result = HectorSLAM(hp).run_log(_progress(records, "hector"))
+    result = HectorSLAM(hp).run_log(progress(records, "hector"))
     m = result.map
     return MethodResult(m.data, m.resolution, m.origin, result.poses, result.trajectory, notes)
 
@@ -124,7 +108,7 @@ def run_gmapping(
     records: LaserLog, params: dict[str, object], *, seed: int, smooth: bool
 ) -> MethodResult:
     slam = GMapping(GMappingParams.from_ros(params), rng=np.random.default_rng(seed))
-    result = slam.run_log(_progress(records, "gmapping"), interpolate=smooth)
+    result = slam.run_log(progress(records, "gmapping"), interpolate=smooth)
     m = result.map
     traj = Trajectory.from_poses(list(records.timestamp_texts), result.poses)
     notes = [
@@ -132,16 +116,6 @@ def run_gmapping(
         f"{slam.recoveries} odometry-failure recoveries"
     ]
     return MethodResult(m.data, m.resolution, m.origin_xy, result.poses, traj, notes)
-
-
-def _params(items: list[str] | None) -> dict[str, object]:
-    out: dict[str, object] = {}
-    for item in items or []:
-        name, sep, value = item.partition(":=")
-        if not sep or not name:
-            raise SlamError(f"--param expects name:=value, got {item!r}")
-        out[name] = yaml.safe_load(value)
-    return out
 
 
 def _png(path: Path, data: np.ndarray, resolution: float, origin: tuple[float, float],
@@ -175,43 +149,18 @@ def _png(path: Path, data: np.ndarray, resolution: float, origin: tuple[float, f
 
 
 def run(
-    log: Annotated[
-        Path, typer.Argument(help="CARMEN .clf(.gz/.bz2), ROS 1 .bag, ROS 2 bag or .mcap.")
-    ],
+    log: LogArgument,
     method: Annotated[
         str, typer.Option("--method", "-m", help="hector, gmapping or graph.")
     ] = "hector",
     out: Annotated[Path, typer.Option("--out", "-o", help="Output folder.")] = Path("slam_out"),
-    param: Annotated[
-        list[str] | None,
-        typer.Option("--param", "-p", help="A method parameter, ROS name:=value (repeatable)."),
-    ] = None,
-    scan_topic: Annotated[
-        str, typer.Option("--scan-topic", help="Bags: the LaserScan topic.")
-    ] = "/scan",
-    odom_topic: Annotated[
-        str,
-        typer.Option(
-            "--odom-topic",
-            help="Bags: the Odometry topic; '' takes odometry from TF (odom frame -> base "
-            "frame on --tf-topic).",
-        ),
-    ] = "/odom",
-    tf_topic: Annotated[str, typer.Option("--tf-topic", help="Bags: the TF topic.")] = "/tf",
-    odom_frame: Annotated[
-        str, typer.Option("--odom-frame", help="Bags: the odometry frame (TF odometry).")
-    ] = "odom",
-    base_frame: Annotated[
-        str | None,
-        typer.Option(
-            "--base-frame",
-            help="Bags: the robot frame (default: the Odometry messages' child frame, or "
-            "the TF child of the odometry frame).",
-        ),
-    ] = None,
-    first: Annotated[
-        int | None, typer.Option("--first", help="Use only the first N scans of the log.")
-    ] = None,
+    param: ParamOption = None,
+    scan_topic: ScanTopicOption = "/scan",
+    odom_topic: OdomTopicOption = "/odom",
+    tf_topic: TfTopicOption = "/tf",
+    odom_frame: OdomFrameOption = "odom",
+    base_frame: BaseFrameOption = None,
+    first: FirstOption = None,
     seed: Annotated[
         int, typer.Option("--seed", help="Seed of the random draws (gmapping's particles).")
     ] = 0,
@@ -228,7 +177,7 @@ def run(
     """Map a recorded log: DIR/map.yaml + map.pgm, DIR/map.png, DIR/trajectory.tum."""
     if method not in METHODS:
         raise SlamError(f"unknown method {method!r} (hector, gmapping or graph)")
-    params = _params(param)
+    params = parse_params(param, SlamError)
     # parameter errors before the (long) log reading
     if method == "hector":
         HectorParams.from_ros(params)
@@ -237,21 +186,16 @@ def run(
     else:
         GraphParams.from_ros(params)
     started = time.monotonic()
-    if log.suffix in (".clf", ".gz", ".bz2"):
-        records = load_log(log)
-    else:
-        records = load_log(
-            log,
-            scan_topic=scan_topic,
-            odom_topic=odom_topic or None,
-            tf_topic=tf_topic,
-            odom_frame=odom_frame,
-            base_frame=base_frame,
-        )
-    if first is not None:
-        if first < 2:
-            raise SlamError(f"--first must be at least 2, got {first}")
-        records = records[:first]
+    records = read_log(
+        log,
+        scan_topic=scan_topic,
+        odom_topic=odom_topic,
+        tf_topic=tf_topic,
+        odom_frame=odom_frame,
+        base_frame=base_frame,
+        first=first,
+        error=SlamError,
+    )
     typer.echo(f"{len(records)} scans from {log}", err=True)
     if method == "hector":
         res = run_hector(records, params)

@@ -20,6 +20,7 @@ from roverlab.description.node import JointStatePublisher, RobotStatePublisher
 from roverlab.errors import RoverlabError
 from roverlab.geometry import quat_from_rpy
 from roverlab.launch.xml import LaunchError, NodeSpec
+from roverlab.localization.amcl.node import AmclNode
 from roverlab.mapping.gmapping.node import SlamGMapping
 from roverlab.mapping.graph.node import SlamKarto, SlamToolbox
 from roverlab.mapping.hector.node import HectorMapping
@@ -288,6 +289,7 @@ REGISTRY[("slam_toolbox", "async_slam_toolbox_node")] = _slam_node(SlamToolbox)
 REGISTRY[("slam_toolbox", "sync_slam_toolbox_node")] = _slam_node(SlamToolbox)
 REGISTRY[("slam_karto", "slam_karto")] = _slam_node(SlamKarto)
 REGISTRY[("costmap_2d", "costmap_2d_node")] = _slam_node(Costmap2DNode)
+REGISTRY[("amcl", "amcl")] = _slam_node(AmclNode)
 
 
 def _unavailable(reason: str) -> NodeFactory:

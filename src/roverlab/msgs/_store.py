@@ -324,6 +324,14 @@ class MessageStore:
         self._canonical[key] = full
         return full
 
+    def has(self, name: str) -> bool:
+        """Whether a type of that name is known (or can be loaded from a type source)."""
+        try:
+            self.resolve(name)
+        except UnknownTypeError:
+            return False
+        return True
+
     def spec(self, ref: object) -> TypeSpec:
         """Field layout of a type given by name, class, factory or message.
 

@@ -2,7 +2,8 @@
 
 * :class:`Scene`: the static 2.5-D world (vertical wall segments, vertical cylinders).
 * :func:`cast_2d`, :func:`cast_2d_many`: exact planar laser ranges in a Scene.
-* :func:`cast_grid`, :func:`cast_grid_many`: exact planar ranges in an occupancy grid.
+* :func:`cast_grid`, :func:`cast_grid_many`: exact planar ranges in an occupancy grid;
+  :func:`grid_ray`, their compiled one-ray kernel, for other kernels.
 * :func:`render`: RGB + depth images of a pinhole camera; :func:`depth_to_points`,
   :func:`optical_to_body`, :func:`body_to_optical` for point clouds.
 * :func:`scene_grid`: the uniform-grid accelerator every Scene kernel walks (cached).
@@ -21,7 +22,7 @@ from roverlab.raycast.camera import (
     render,
 )
 from roverlab.raycast.errors import RaycastError, RaycastInputError
-from roverlab.raycast.lidar import cast_2d, cast_2d_many, cast_grid, cast_grid_many
+from roverlab.raycast.lidar import cast_2d, cast_2d_many, cast_grid, cast_grid_many, grid_ray
 from roverlab.raycast.scene import Scene
 
 __all__ = [
@@ -39,6 +40,7 @@ __all__ = [
     "cast_grid",
     "cast_grid_many",
     "depth_to_points",
+    "grid_ray",
     "optical_to_body",
     "render",
     "scene_grid",

@@ -24,7 +24,7 @@ from roverlab.raycast.accel import Grid, circle_hit, grid_entry, scene_grid, seg
 from roverlab.raycast.errors import RaycastInputError
 from roverlab.raycast.scene import Scene
 
-__all__ = ["cast_2d", "cast_2d_many", "cast_grid", "cast_grid_many"]
+__all__ = ["cast_2d", "cast_2d_many", "cast_grid", "cast_grid_many", "grid_ray"]
 
 _jit = numba.njit(cache=True, nogil=True)
 
@@ -189,6 +189,13 @@ def _grid_ray(
                 return math.inf
         if grid[iy, ix] == occ:
             return t
+
+
+#: The grid ray kernel itself, for other compiled kernels (amcl's beam model): ``grid_ray(gx,
+#: gy, dx, dy, rmax, grid, occ)`` with the origin and ``rmax`` in cell units and ``(dx, dy)``
+#: a unit direction; returns the distance in cells to the first cell equal to ``occ``
+#: (``inf``: none within ``rmax``; cells outside the grid are free).
+grid_ray = _grid_ray
 
 
 @_jit

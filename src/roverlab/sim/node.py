@@ -251,6 +251,22 @@ class SimulatorNode(Node):
                 self._noise = self._slip_rng.standard_normal((self._slip_block, 2))
                 self._noise_pos = 0
 
+    def teleport(self, x: float, y: float, yaw: float) -> None:
+        """Put the robot at ``(x, y, yaw)`` in the world at once, at rest (Gazebo's
+        ``set_model_state``). Encoder odometry does not see the jump; world-source
+        odometry does (it reports the world pose, as Gazebo's plugin).
+
+        Raises:
+            ValueError: a non-finite pose.
+        """
+        if not all(math.isfinite(v) for v in (x, y, yaw)):
+            raise ValueError(f"teleport pose must be finite, got ({x}, {y}, {yaw})")
+        self.advance()
+        st = self._state
+        st[S_X], st[S_Y], st[S_TH] = x, y, float(wrap_angle(yaw))
+        for i in (S_VL, S_VR, S_TL, S_TR, S_V, S_W, S_DV):
+            st[i] = 0.0
+
     # ----------------------------------------------------------------- commands
     def _on_cmd(self, msg: Any) -> None:
         v, w = float(msg.linear.x), float(msg.angular.z)

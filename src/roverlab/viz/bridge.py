@@ -58,6 +58,7 @@ from roverlab.viz.displays import (
     color_buckets,
     decimate,
     map_change,
+    pose_covariance_primitives,
     poses_in_fixed,
 )
 from roverlab.viz.errors import DashboardError
@@ -371,6 +372,7 @@ class VizBridge:
             "path": self._on_path,
             "pose_array": self._on_pose_array,
             "pose": self._on_pose,
+            "pose_with_covariance": self._on_pose_with_covariance,
             "marker": self._on_marker,
             "marker_array": self._on_marker_array,
             "image": self._on_image,
@@ -506,6 +508,28 @@ class VizBridge:
         arr = self._posed(state, msg.header, [msg.pose])
         if arr is not None:
             state.frame = Versioned(self._next(), encode_poses(arr))
+
+    def _on_pose_with_covariance(self, state: DisplayState, msg: Any) -> None:
+        """/amcl_pose: the arrow, the position covariance ellipse (turned into the fixed
+        frame) and the yaw wedge, sent as marker primitives."""
+        tf, why = self._lookup_why(str(msg.header.frame_id), _stamp_time(msg.header))
+        if not self._tf_status(state, tf, why):
+            return
+        assert tf is not None
+        p = msg.pose.pose
+        q = (p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w)
+        pose = poses_in_fixed(tf, np.array([[p.position.x, p.position.y, p.position.z]]),
+                              np.array([q]))[0]  # fmt: skip
+        cov = np.asarray(msg.pose.covariance, dtype=np.float64).reshape(6, 6)
+        rot = tf.yaw
+        r = np.array([[math.cos(rot), -math.sin(rot)], [math.sin(rot), math.cos(rot)]])
+        cfg = state.config
+        items = pose_covariance_primitives(
+            (float(pose[0]), float(pose[1]), float(pose[2])), r @ cov[:2, :2] @ r.T,
+            float(cov[5, 5]), rgb=_rgb(cfg), alpha=float(cfg.option("alpha")),
+            length=float(cfg.option("length")), scale=float(cfg.option("covariance_scale")),
+        )  # fmt: skip
+        state.frame = Versioned(self._next(), json.dumps(items))
 
     def _markers_changed(self, state: DisplayState) -> None:
         assert state.markers is not None

@@ -159,6 +159,15 @@ DISPLAY_KINDS: Final[dict[str, DisplayKind]] = {
             length=1.3,
         ),
         _kind(
+            "pose_with_covariance",
+            ("geometry_msgs/msg/PoseWithCovarianceStamped",),
+            "/amcl_pose",
+            color=[255, 25, 0],
+            alpha=1.0,
+            length=1.0,
+            covariance_scale=1.0,
+        ),
+        _kind(
             "image",
             ("sensor_msgs/msg/Image", "sensor_msgs/msg/CompressedImage"),
             "/image_raw",
@@ -182,6 +191,7 @@ RVIZ_CLASSES: Final[dict[str, str]] = {
     "rviz/Marker": "marker",
     "rviz/MarkerArray": "marker_array",
     "rviz/Pose": "pose",
+    "rviz/PoseWithCovariance": "pose_with_covariance",
     "rviz/Image": "image",
     "rviz/Camera": "image",
 }
@@ -273,6 +283,7 @@ def default_config(fixed_frame: str = "map") -> DashboardConfig:
         ("path", "Global plan", "/move_base/NavfnROS/plan", {"color": [25, 255, 0]}),
         ("path", "Local plan", "/move_base/DWAPlannerROS/local_plan", {"color": [0, 12, 255]}),
         ("pose_array", "Particles", "/particlecloud", {}),
+        ("pose_with_covariance", "AMCL pose", "/amcl_pose", {}),
         ("point_cloud2", "PointCloud2", "/camera/depth/points", {}),
         ("marker", "Marker", "/visualization_marker", {}),
         ("marker_array", "MarkerArray", "/visualization_marker_array", {}),
@@ -436,7 +447,7 @@ def _rviz_display(d: Mapping[str, Any], kind: str, where: str) -> DisplayConfig:
         if "Show Axes" in d:
             opts["show_axes"] = bool(d["Show Axes"])
         num("Marker Scale", "scale")
-    elif kind in ("odometry", "pose", "pose_array"):
+    elif kind in ("odometry", "pose", "pose_array", "pose_with_covariance"):
         if kind == "odometry":
             num("Keep", "keep", integer=True)
             num("Position Tolerance", "position_tolerance")

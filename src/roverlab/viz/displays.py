@@ -36,6 +36,7 @@ __all__ = [
     "decimate",
     "map_change",
     "marker_primitives",
+    "pose_covariance_primitives",
     "poses_in_fixed",
 ]
 
@@ -109,6 +110,59 @@ def poses_in_fixed(
     )
     heading = quat_rotate(fixed_from_frame.rotation, axis).reshape(-1, 3)
     return np.column_stack((pos[:, :2], np.arctan2(heading[:, 1], heading[:, 0])))
+
+
+def pose_covariance_primitives(
+    pose: tuple[float, float, float],
+    covariance_xy: NDArray[np.floating[Any]],
+    yaw_variance: float,
+    *,
+    rgb: tuple[int, int, int] | list[int],
+    alpha: float,
+    length: float,
+    scale: float = 1.0,
+    segments: int = 48,
+) -> list[dict[str, Any]]:
+    """rviz's PoseWithCovariance display as primitives (in the fixed frame): the pose's
+    arrow, the position covariance as the ``scale``-sigma ellipse (filled, outlined) and
+    the yaw's ``scale``-sigma wedge in front of the robot.
+
+    Args:
+        pose: ``(x, y, yaw)`` in the fixed frame.
+        covariance_xy: ``(2, 2)`` position covariance, already in the fixed frame (m^2).
+        yaw_variance: yaw variance (rad^2).
+        rgb: the arrow's colour (0..255); the ellipse takes it at a third of ``alpha``.
+        alpha: opacity of the arrow.
+        length: arrow length (m).
+        scale: how many standard deviations the ellipse and wedge span.
+        segments: points on the ellipse.
+    """
+    x, y, yaw = (float(v) for v in pose)
+    c = np.asarray(covariance_xy, dtype=np.float64).reshape(2, 2)
+    c = 0.5 * (c + c.T)
+    rgba = [round(v / 255.0, 3) for v in rgb]
+    solid = [*rgba, round(float(alpha), 3)]
+    faint = [*rgba, round(float(alpha) / 3.0, 3)]
+    out: list[dict[str, Any]] = []
+    if np.isfinite(c).all():
+        values, vectors = np.linalg.eigh(c)
+        radii = scale * np.sqrt(np.clip(values, 0.0, None))
+        t = np.linspace(0.0, 2.0 * math.pi, segments, endpoint=False)
+        ring = (vectors @ (radii[:, None] * np.vstack((np.cos(t), np.sin(t))))).T + np.array([x, y])
+        pts = [[round(float(a), 4), round(float(b), 4)] for a, b in ring]
+        out.append({"shape": "polygon", "rgba": faint, "points": pts})
+        out.append({"shape": "polyline", "rgba": solid, "points": [*pts, pts[0]], "width": 0.0})
+    if math.isfinite(yaw_variance) and yaw_variance > 0.0:
+        half = min(math.pi, scale * math.sqrt(yaw_variance))
+        arc = np.linspace(yaw - half, yaw + half, 16)
+        r = 0.6 * length
+        wedge = [[x, y]] + [[x + r * math.cos(a), y + r * math.sin(a)] for a in arc]
+        pts = [[round(float(a), 4), round(float(b), 4)] for a, b in wedge]
+        out.append({"shape": "polygon", "rgba": faint, "points": pts})
+    out.append({"shape": "arrow", "rgba": solid, "points": [[round(x, 4), round(y, 4)]],
+                "yaw": round(yaw, 4), "length": round(float(length), 4),
+                "width": round(0.04 * float(length), 4)})  # fmt: skip
+    return out
 
 
 @dataclass

@@ -1,0 +1,144 @@
+"""``roverlab run``: rosrun — a ROS 1 Python script, or a node of roverlab's registry."""
+
+from __future__ import annotations
+
+import shlex
+import time
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from roverlab.cli.common import NetworkOptions, network_options, run_context
+from roverlab.core import Context, Node, configure_logging
+from roverlab.core.transport.zenoh import ZenohTransport, query_graph
+from roverlab.description import find_package
+from roverlab.description.errors import DescriptionError
+from roverlab.errors import RoverlabError
+from roverlab.launch import LaunchError
+from roverlab.launch.registry import REGISTRY, LaunchState
+from roverlab.launch.xml import NodeSpec
+from roverlab.ros1 import run_script
+from roverlab.ros1.rospy.runtime import parse_command_line
+
+CLOCKS = ("auto", "wall", "external")
+
+
+class RunError(RoverlabError):
+    """``roverlab run`` cannot start what it was asked to."""
+
+
+def _connect(options: NetworkOptions, clock: str) -> tuple[ZenohTransport, str, str]:
+    """The transport, and the clock mode (``auto``: follow /clock when someone publishes
+    it, as a ROS node with /use_sim_time does next to a simulator; else wall time)."""
+    if clock not in CLOCKS:
+        raise RunError(f"unknown --clock {clock!r} ({', '.join(CLOCKS)})")
+    transport = ZenohTransport(options.zenoh_options())
+    if clock != "auto":
+        return transport, clock, ""
+    time.sleep(0.3)  # the router's declarations reach a fresh session first
+    deadline = time.monotonic() + 1.0
+    while True:
+        clocks = [
+            e
+            for e in query_graph(transport.session, transport.domain, 0.5)
+            if e.kind == "publisher" and e.topic == "/clock"
+        ]
+        if clocks:
+            return transport, "external", f"following /clock from {clocks[0].node} (sim time)"
+        if time.monotonic() >= deadline:
+            return transport, "wall", ""
+        time.sleep(0.2)
+
+
+def _resolve(target: list[str]) -> tuple[Path | None, NodeSpec | None, list[str]]:
+    """A script path, or a registry node, and the rest of the arguments."""
+    first = target[0]
+    if Path(first).is_file():
+        return Path(first), None, target[1:]
+    if len(target) < 2:
+        raise RunError(f"{first}: no such file (usage: roverlab run SCRIPT.py | PKG TYPE)")
+    pkg, type_ = target[0], target[1]
+    rest = target[2:]
+    if (pkg, type_) in REGISTRY:
+        cl = parse_command_line(rest)
+        spec = NodeSpec(
+            pkg=pkg,
+            type=type_,
+            name=cl.special.get("__name", Path(type_).stem),
+            namespace=cl.special.get("__ns", "/"),
+            args=" ".join(shlex.quote(a) for a in cl.plain),
+            params=dict(cl.params),
+            remaps=dict(cl.remaps),
+            source=f"roverlab run {pkg} {type_}",
+        )
+        return None, spec, rest
+    try:
+        folder = find_package(pkg)
+    except DescriptionError as err:
+        raise RunError(f"{pkg} {type_}: not a roverlab node, and {err}") from None
+    matches = sorted(p for p in folder.rglob(type_) if p.is_file())
+    if not matches:
+        raise RunError(
+            f"{pkg} {type_}: not a roverlab node and no file {type_!r} in package {pkg} ({folder})"
+        )
+    return matches[0], None, rest
+
+
+def run(
+    ctx: typer.Context,
+    target: Annotated[
+        list[str],
+        typer.Argument(
+            metavar="SCRIPT.py [ARGS...] | PKG TYPE [ARGS...]",
+            help="A ROS 1 Python script, a script in a package, or a roverlab node "
+            "(e.g. map_server map_server maze.yaml). ARGS may hold name:=value remaps, "
+            "_param:=value private parameters, __name:= and __ns:=.",
+        ),
+    ],
+    clock: Annotated[
+        str,
+        typer.Option(
+            "--clock",
+            help="auto: sim time from /clock when something publishes it, else wall time; "
+            "wall; external (wait for /clock).",
+        ),
+    ] = "auto",
+) -> None:
+    """Run a rospy script unchanged (import rospy, actionlib, ..._msgs) or a node (rosrun).
+
+    Options for roverlab go before the target; everything after it goes to the script.
+    """
+    script, spec, rest = _resolve(list(target) + list(ctx.args))
+    transport, mode, note = _connect(network_options(ctx), clock)
+    if note:
+        typer.echo(f"note: {note}", err=True)
+    context = Context(clock=mode, publish_clock=False)
+    context.add_transport(transport)
+    if script is not None:
+        try:
+            code = run_script(script, rest, context)
+        finally:
+            context.shutdown()
+        if code:
+            raise typer.Exit(code)
+        return
+    assert spec is not None
+    configure_logging()
+    try:
+        node: Node | None = REGISTRY[(spec.pkg, spec.type)](
+            LaunchState(context=context, params={}), spec
+        )
+    except LaunchError:
+        context.shutdown()
+        raise
+    if node is not None:
+        unused = node.unused_parameter_overrides()
+        if unused:
+            typer.echo(
+                f"warning: parameters not used by {spec.pkg}/{spec.type}: "
+                f"{', '.join(sorted(unused))}",
+                err=True,
+            )
+            node.discard_parameter_overrides(unused)
+    run_context(context, None)

@@ -1,0 +1,1 @@
+"""Localization on a known map: :mod:`roverlab.localization.amcl` (ROS 1 ``amcl``)."""
