@@ -15,6 +15,7 @@ from roverlab.navigation.costmap import Costmap2D
 from roverlab.navigation.errors import (
     GoalOccupiedError,
     GoalOutsideMapBoundsError,
+    NavigationParamsError,
     NoValidPathCouldBeFoundError,
     StartOccupiedError,
     StartOutsideMapBoundsError,
@@ -230,3 +231,14 @@ def test_deterministic_and_message_conversions() -> None:
     assert len(pointcloud2_to_xyz(cloud)) == int(np.sum(p1.potential < 1e7))
     grid = potential_to_grid(p1.potential, p1.potential_origin, cm.resolution, "map")
     assert grid.info.width == cm.size_x
+
+
+def test_planner_parameters_from_ros() -> None:
+    p, _ = NavfnParams.from_ros({"allow_unknown": False, "default_tolerance": 1})
+    assert p == NavfnParams(allow_unknown=False, default_tolerance=1.0)
+    g, _ = GlobalPlannerParams.from_ros({"use_dijkstra": False, "orientation_mode": 1.0})
+    assert (g.use_dijkstra, g.orientation_mode) == (False, 1)
+    with pytest.raises(NavigationParamsError, match="unknown parameter 'use_dijkstraa'"):
+        GlobalPlannerParams.from_ros({"use_dijkstraa": True})
+    with pytest.raises(NavigationParamsError, match="default_tolerance must be >= 0"):
+        NavfnParams.from_ros({"default_tolerance": -1.0})

@@ -21,7 +21,9 @@ the goal. ``publish_potential`` keeps the potential in :attr:`GlobalPlanner.pote
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -33,7 +35,7 @@ from roverlab.navigation.errors import (
     NoValidPathCouldBeFoundError,
     StartOutsideMapBoundsError,
 )
-from roverlab.navigation.params import check
+from roverlab.navigation.params import build_params, check
 from roverlab.navigation.planners.base import Path2D, diagnose_failure, tolerance_candidates
 from roverlab.navigation.planners.gp_kernels import astar, clear_endpoint, dijkstra, grid_path
 from roverlab.navigation.planners.navfn_kernels import POT_HIGH, calc_path
@@ -57,6 +59,7 @@ class GlobalPlannerParams:
     neutral_cost: int = 50
     cost_factor: float = 3.0
     publish_potential: bool = True
+    publish_scale: int = 100
     orientation_mode: int = 0
     orientation_window_size: int = 1
     outline_map: bool = True
@@ -72,6 +75,17 @@ class GlobalPlannerParams:
             f"{w}: orientation_mode must be 0..6, got {self.orientation_mode}",
         )
         check(self.orientation_window_size >= 1, f"{w}: orientation_window_size must be >= 1")
+        check(1 <= self.publish_scale <= 100, f"{w}: publish_scale must be in 1..100")
+
+    @classmethod
+    def from_ros(cls, values: Mapping[str, Any]) -> tuple[GlobalPlannerParams, tuple[str, ...]]:
+        """From ``GlobalPlanner/...`` parameters (ROS names).
+
+        Raises:
+            NavigationParamsError: an unknown name or a bad value.
+        """
+        p, res = build_params(cls, values, where="global_planner")
+        return p, res.warnings
 
 
 class GlobalPlanner:

@@ -24,7 +24,9 @@ towards the origin).
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -36,7 +38,7 @@ from roverlab.navigation.errors import (
     NoValidPathCouldBeFoundError,
     StartOutsideMapBoundsError,
 )
-from roverlab.navigation.params import check
+from roverlab.navigation.params import build_params, check
 from roverlab.navigation.planners.base import Path2D, diagnose_failure, tolerance_candidates
 from roverlab.navigation.planners.navfn_kernels import POT_HIGH, calc_path, propagate
 
@@ -59,6 +61,16 @@ class NavfnParams:
         check(self.default_tolerance >= 0, "navfn: default_tolerance must be >= 0")
         check(self.planner_window_x >= 0, "navfn: planner_window_x must be >= 0")
         check(self.planner_window_y >= 0, "navfn: planner_window_y must be >= 0")
+
+    @classmethod
+    def from_ros(cls, values: Mapping[str, Any]) -> tuple[NavfnParams, tuple[str, ...]]:
+        """From ``NavfnROS/...`` parameters (ROS names).
+
+        Raises:
+            NavigationParamsError: an unknown name or a bad value.
+        """
+        p, res = build_params(cls, values, where="navfn")
+        return p, res.warnings
 
 
 def navfn_costs(costs: NDArray[np.uint8], allow_unknown: bool) -> NDArray[np.uint8]:
