@@ -108,3 +108,45 @@ def test_bad_costmap_parameter_fails_the_node_with_its_name() -> None:
     with pytest.raises(NavigationParamsError, match="costmap: unknown parameter 'update_frequncy'"):
         Costmap2DNode(ctx, parameter_overrides={"costmap/update_frequncy": 5.0})
     ctx.shutdown()
+
+
+def test_costmap_node_from_a_launch_file_with_pre_hydro_rosparam_files(tmp_path: Any) -> None:
+    from roverlab.launch import build_launch
+
+    (tmp_path / "common.yaml").write_text(
+        "obstacle_range: 3.0\nraytrace_range: 3.5\nfootprint: [[-0.1, -0.1], [-0.1, 0.1], "
+        "[0.1, 0.1], [0.1, -0.1]]\ninflation_radius: 0.4\ncost_scaling_factor: 3.0\n"
+        "map_type: costmap\nobservation_sources: scan\n"
+        "scan: {sensor_frame: laser, data_type: LaserScan, topic: scan, marking: true, "
+        "clearing: true}\n"
+    )
+    (tmp_path / "global.yaml").write_text(
+        "costmap:\n  global_frame: map\n  robot_base_frame: base_link\n"
+        "  update_frequency: 5.0\n  publish_frequency: 1.0\n  static_map: true\n"
+    )
+    launch_file = tmp_path / "costmap.launch"
+    launch_file.write_text(
+        f"""<launch>
+  <node pkg="costmap_2d" type="costmap_2d_node" name="costmap_node">
+    <rosparam file="{tmp_path}/common.yaml" command="load" ns="costmap"/>
+    <rosparam file="{tmp_path}/global.yaml" command="load"/>
+  </node>
+</launch>"""
+    )
+    ctx = Context()
+    _world(ctx, SE2(2.0, 5.0, 0.0))
+    launch = build_launch(launch_file, context=ctx)
+    (node,) = launch.nodes
+    assert isinstance(node, Costmap2DNode)
+    p = node.costmap_ros.params
+    assert [s.type.split("::")[1] for s in p.plugins] == [
+        "StaticLayer",
+        "ObstacleLayer",
+        "InflationLayer",
+    ]
+    assert p.footprint is not None and len(p.footprint) == 4
+    ctx.spin_for(1.0)
+    grid = node.costmap_ros.costmap
+    assert grid.size_x == 100 and grid.get_cost(50, 50) == 254
+    assert not launch.warnings, launch.warnings
+    ctx.shutdown()
