@@ -292,3 +292,19 @@ def test_inflation_window_covers_last_and_new_bounds() -> None:
     static.incoming_update(10, 10, 1, 1, [0])  # type: ignore[attr-defined]
     lc.update_map(0.0, 0.0, 0.0)
     assert not lc.costmap.costs.any()  # the old inflation went with the obstacle
+
+
+def test_clear_area_outside_a_window_as_the_clear_costmap_recovery() -> None:
+    lc = _obstacle_costmap()
+    layer = lc.plugin("obstacle_layer")
+    pts = [[1.5, 1.5, 0.1], [4.5, 4.5, 0.1], [5.5, 8.5, 0.1]]
+    layer.add_observation("scan", [1.5, 6.5, 0.1], pts, 0.0, 0.0)  # type: ignore[attr-defined]
+    lc.update_map(1.5, 6.5, 0.0)
+    assert np.count_nonzero(lc.costmap.costs == LETHAL_OBSTACLE) == 3
+    layer.buffers["scan"].clear()  # type: ignore[attr-defined]
+    layer.clear_area(3, 3, 6, 6, True)  # type: ignore[attr-defined]  # keep cells 4..5 only
+    lc.update_map(1.5, 6.5, 0.0)
+    assert np.argwhere(lc.costmap.costs == LETHAL_OBSTACLE).tolist() == [[4, 4]]
+    layer.clear_area(3, 3, 6, 6, False)  # type: ignore[attr-defined]
+    lc.update_map(1.5, 6.5, 0.0)
+    assert not (lc.costmap.costs == LETHAL_OBSTACLE).any()

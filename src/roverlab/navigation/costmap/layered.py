@@ -168,6 +168,24 @@ class CostmapLayer(Layer):
     def reset(self) -> None:
         self.grid.reset_maps()
 
+    def clear_area(self, start_x: int, start_y: int, end_x: int, end_y: int, invert: bool) -> None:
+        """costmap_2d's ``CostmapLayer::clearArea``: reset the cells strictly inside the cell
+        box ``(start_x, end_x) x (start_y, end_y)`` (``invert`` False) or outside it
+        (``invert`` True), then ask for the whole layer to be redrawn at the next update.
+        move_base's clear_costmap recovery clears outside a window (``reset_distance``)
+        around the robot with ``invert`` True."""
+        g = self.grid
+        xs = np.arange(g.size_x)
+        ys = np.arange(g.size_y)
+        inside = ((ys > start_y) & (ys < end_y))[:, None] & ((xs > start_x) & (xs < end_x))[None, :]
+        g.costs[inside != invert] = g.default_value
+        self.add_extra_bounds(
+            g.origin_x,
+            g.origin_y,
+            g.origin_x + g.size_in_meters_x,
+            g.origin_y + g.size_in_meters_y,
+        )
+
 
 class LayeredCostmap:
     """The master costmap and its plugins (costmap_2d's ``LayeredCostmap``).
