@@ -302,9 +302,9 @@ def test_clear_area_outside_a_window_as_the_clear_costmap_recovery() -> None:
     lc.update_map(1.5, 6.5, 0.0)
     assert np.count_nonzero(lc.costmap.costs == LETHAL_OBSTACLE) == 3
     layer.buffers["scan"].clear()  # type: ignore[attr-defined]
-    layer.clear_area(3, 3, 6, 6, True)  # type: ignore[attr-defined]  # keep cells 4..5 only
+    layer.clear_area(3, 3, 6, 6, False)  # type: ignore[attr-defined]  # keep cells 4..5 only
     lc.update_map(1.5, 6.5, 0.0)
     assert np.argwhere(lc.costmap.costs == LETHAL_OBSTACLE).tolist() == [[4, 4]]
-    layer.clear_area(3, 3, 6, 6, False)  # type: ignore[attr-defined]
+    layer.clear_area(3, 3, 6, 6, True)  # type: ignore[attr-defined]
     lc.update_map(1.5, 6.5, 0.0)
     assert not (lc.costmap.costs == LETHAL_OBSTACLE).any()

@@ -19,6 +19,7 @@ __all__ = [
     "bresenham",
     "clear_rays",
     "convex_fill",
+    "footprint_cost",
     "inflate",
     "line_cost",
     "mark_points",
@@ -273,3 +274,59 @@ def inflate(
                     nn += 1
             k = node_next[k]
     return taken
+
+
+@_jit
+def footprint_cost(
+    costs: NDArray[np.uint8],
+    res: float,
+    ox: float,
+    oy: float,
+    x: float,
+    y: float,
+    th: float,
+    fp: NDArray[np.float64],
+    scale: float,
+    buf: NDArray[np.int64],
+) -> float:
+    """base_local_planner's ``footprintCost`` at ``(x, y, th)`` (CostmapModel's edge
+    rasterisation of the footprint ``fp`` scaled by ``scale``): the highest cost on its
+    outline (and its centre cell), or -6 when a cell is lethal or unknown or the footprint
+    leaves the grid. ``buf`` is scratch space for the Bresenham cells."""
+    h, w = costs.shape
+    if x < ox or y < oy:
+        return -6.0
+    cx = int((x - ox) / res)
+    cy = int((y - oy) / res)
+    if cx >= w or cy >= h:
+        return -6.0
+    center = float(costs[cy, cx])
+    m = fp.shape[0]
+    if m < 3:
+        c = costs[cy, cx]
+        if c in (LETHAL, INSCRIBED, NO_INFO):
+            return -6.0
+        return center
+    c = math.cos(th)
+    s = math.sin(th)
+    best = 0.0
+    px0 = 0
+    py0 = 0
+    for k in range(m + 1):
+        j = k % m
+        wx = x + scale * (fp[j, 0] * c - fp[j, 1] * s)
+        wy = y + scale * (fp[j, 0] * s + fp[j, 1] * c)
+        if wx < ox or wy < oy:
+            return -6.0
+        mx = int((wx - ox) / res)
+        my = int((wy - oy) / res)
+        if mx >= w or my >= h:
+            return -6.0
+        if k > 0:
+            lc = line_cost(costs, px0, py0, mx, my, buf)
+            if lc < 0:
+                return -6.0
+            best = max(best, lc)
+        px0 = mx
+        py0 = my
+    return max(best, center)

@@ -169,16 +169,17 @@ class CostmapLayer(Layer):
         self.grid.reset_maps()
 
     def clear_area(self, start_x: int, start_y: int, end_x: int, end_y: int, invert: bool) -> None:
-        """costmap_2d's ``CostmapLayer::clearArea``: reset the cells strictly inside the cell
-        box ``(start_x, end_x) x (start_y, end_y)`` (``invert`` False) or outside it
-        (``invert`` True), then ask for the whole layer to be redrawn at the next update.
-        move_base's clear_costmap recovery clears outside a window (``reset_distance``)
-        around the robot with ``invert`` True."""
+        """costmap_2d's ``CostmapLayer::clearArea``: reset the cells outside the cell box
+        ``(start_x, end_x) x (start_y, end_y)`` (bounds excluded) when ``invert`` is False,
+        or inside it when ``invert`` is True (as ROS: a cell is kept when its being inside
+        differs from ``invert``), then ask for the whole layer to be redrawn at the next
+        update. move_base's clear_costmap recovery (``invert_area_to_clear`` False by
+        default) so clears everything farther than ``reset_distance / 2`` from the robot."""
         g = self.grid
         xs = np.arange(g.size_x)
         ys = np.arange(g.size_y)
         inside = ((ys > start_y) & (ys < end_y))[:, None] & ((xs > start_x) & (xs < end_x))[None, :]
-        g.costs[inside != invert] = g.default_value
+        g.costs[inside == invert] = g.default_value
         self.add_extra_bounds(
             g.origin_x,
             g.origin_y,

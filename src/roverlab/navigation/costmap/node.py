@@ -34,6 +34,7 @@ from roverlab.navigation.costmap.params import CostmapParams, make_layered_costm
 from roverlab.navigation.costmap.publisher import CostmapPublisherState, footprint_message
 from roverlab.navigation.costmap.static_layer import StaticLayer
 from roverlab.navigation.errors import CostmapError, NavigationError
+from roverlab.navigation.node_params import parameters_under
 from roverlab.tf import Buffer, TfMessageFilter, Throttle, TransformException, TransformListener
 
 __all__ = ["Costmap2DNode", "Costmap2DROS"]
@@ -41,27 +42,6 @@ __all__ = ["Costmap2DNode", "Costmap2DROS"]
 _LATCHED = QoSProfile(depth=1, durability="transient_local")
 _UPDATE_TYPE = "map_msgs/msg/OccupancyGridUpdate"
 _SENSOR_QUEUE = 50
-
-
-def _host_parameters(node: Node, name: str) -> dict[str, Any]:
-    """Every override of ``node`` under ``name/`` (declared now, so none is reported as
-    unused), plus the host-level ``footprint`` / ``robot_radius`` (ROS's searchParam)."""
-    values: dict[str, Any] = {}
-    for key in node.unused_parameter_overrides():
-        for prefix in (name + "/", name + "."):  # rosparam (ROS 1) or YAML (ROS 2) names
-            if key.startswith(prefix):
-                values[key[len(prefix) :]] = node.declare_parameter(key, None).value
-    for key in ("footprint", "robot_radius", "footprint_padding"):
-        if key not in values:
-            if node.has_parameter(key):
-                v = node.get_parameter(key).value
-            elif key in node.unused_parameter_overrides():
-                v = node.declare_parameter(key, None).value
-            else:
-                continue
-            if v is not None:
-                values[key] = v
-    return values
 
 
 class Costmap2DROS:
@@ -85,7 +65,10 @@ class Costmap2DROS:
         self.node = node
         self.name = name
         self.tf_buffer = tf_buffer
-        self.params, warnings = CostmapParams.from_ros(_host_parameters(node, name), name=name)
+        values = parameters_under(
+            node, name, searched=("footprint", "robot_radius", "footprint_padding")
+        )
+        self.params, warnings = CostmapParams.from_ros(values, name=name)
         for w in warnings:
             node.get_logger().warning(w)
         p = self.params

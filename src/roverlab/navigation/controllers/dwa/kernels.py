@@ -29,7 +29,7 @@ import numba
 import numpy as np
 from numpy.typing import NDArray
 
-from roverlab.navigation.costmap.kernels import line_cost
+from roverlab.navigation.costmap.kernels import footprint_cost
 
 __all__ = ["rollout", "score_rollouts", "target_distance"]
 
@@ -170,59 +170,6 @@ def _accelerate(
         else:
             out[i] = max(target[i], cur[i] - acc[i] * dt)
     return out[0], out[1], out[2]
-
-
-@_jit
-def _footprint_cost(
-    costs: NDArray[np.uint8],
-    res: float,
-    ox: float,
-    oy: float,
-    x: float,
-    y: float,
-    th: float,
-    fp: NDArray[np.float64],
-    scale: float,
-    buf: NDArray[np.int64],
-) -> float:
-    """ObstacleCostFunction's ``footprintCost`` (CostmapModel's edge rasterisation)."""
-    h, w = costs.shape
-    if x < ox or y < oy:
-        return -6.0
-    cx = int((x - ox) / res)
-    cy = int((y - oy) / res)
-    if cx >= w or cy >= h:
-        return -6.0
-    center = float(costs[cy, cx])
-    m = fp.shape[0]
-    if m < 3:
-        c = costs[cy, cx]
-        if c in (LETHAL, INSCRIBED, NO_INFO):
-            return -6.0
-        return center
-    c = math.cos(th)
-    s = math.sin(th)
-    best = 0.0
-    px0 = 0
-    py0 = 0
-    for k in range(m + 1):
-        j = k % m
-        wx = x + scale * (fp[j, 0] * c - fp[j, 1] * s)
-        wy = y + scale * (fp[j, 0] * s + fp[j, 1] * c)
-        if wx < ox or wy < oy:
-            return -6.0
-        mx = int((wx - ox) / res)
-        my = int((wy - oy) / res)
-        if mx >= w or my >= h:
-            return -6.0
-        if k > 0:
-            lc = line_cost(costs, px0, py0, mx, my, buf)
-            if lc < 0:
-                return -6.0
-            best = max(best, lc)
-        px0 = mx
-        py0 = my
-    return max(best, center)
 
 
 @_jit
@@ -412,7 +359,7 @@ def score_rollouts(
         oc = 0.0
         bad = 0.0
         for i in range(num + extra):
-            fc = _footprint_cost(
+            fc = footprint_cost(
                 costs, res, ox, oy, traj[i, 0], traj[i, 1], traj[i, 2], fp, scale, buf
             )
             if fc < 0:

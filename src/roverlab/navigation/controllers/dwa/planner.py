@@ -386,6 +386,10 @@ class DWAPlanner:
         """LatchedStopRotateController::computeVelocityCommandsStopRotate."""
         p = self.params
         t = p.sim_period
+        goal_th = float(self._goal()[2])
+        if abs(angle_diff(goal_th, pose.theta)) <= p.yaw_goal_tolerance:
+            self._rotating = False  # at the goal's heading: stop (move_base then sees
+            return Velocity2D()  # the robot stopped and ends the goal SUCCEEDED)
         if not self._rotating and not stopped(twist, p.theta_stopped_vel, p.trans_stopped_vel):
             vx = math.copysign(max(0.0, abs(twist.vx) - p.acc_lim_x * t), twist.vx)
             vy = math.copysign(max(0.0, abs(twist.vy) - p.acc_lim_y * t), twist.vy)
@@ -394,7 +398,6 @@ class DWAPlanner:
                 return Velocity2D(vx, vy, vth)
             raise NoValidControlError("dwa_local_planner: stopping cmd in collision")
         self._rotating = True
-        goal_th = float(self._goal()[2])
         ang = angle_diff(goal_th, pose.theta)
         v = min(p.max_vel_theta, max(p.min_vel_theta, abs(ang)))
         max_acc = abs(twist.wz) + p.acc_lim_theta * t
