@@ -10,12 +10,13 @@ from numpy.typing import ArrayLike, NDArray
 
 from roverlab.msgs import (
     Path,
-    PoseStamped,
     array_to_occupancy_grid,
+    poses_from_xytheta,
     xytheta_from_pose,
     xyz_to_pointcloud2,
 )
-from roverlab.msgs.convert import Stamp, pose_from_xytheta, stamp_to_msg
+from roverlab.msgs import classes as mc
+from roverlab.msgs.convert import Stamp, stamp_to_msg
 from roverlab.navigation.planners.navfn_kernels import POT_HIGH
 
 __all__ = ["path_from_msg", "path_to_msg", "potential_to_grid", "potential_to_pointcloud"]
@@ -23,14 +24,10 @@ __all__ = ["path_from_msg", "path_to_msg", "potential_to_grid", "potential_to_po
 
 def path_to_msg(path: ArrayLike, frame_id: str, stamp: Stamp = None) -> Any:
     """An ``(N, 3)`` ``x, y, yaw`` path as a ``nav_msgs/Path`` (every pose stamped alike)."""
-    pts = np.asarray(path, dtype=np.float64).reshape(-1, 3)
     t = stamp_to_msg(stamp)
-    header = {"stamp": t, "frame_id": frame_id}
-    poses = [
-        PoseStamped(header=header, pose=pose_from_xytheta(float(x), float(y), float(a)))
-        for x, y, a in pts
-    ]
-    return Path(header=header, poses=poses)
+    stamped, header = mc.PoseStamped, mc.Header
+    poses = [stamped(header(t, frame_id), p) for p in poses_from_xytheta(path)]
+    return Path(header={"stamp": t, "frame_id": frame_id}, poses=poses)
 
 
 def path_from_msg(msg: Any) -> NDArray[np.float64]:
