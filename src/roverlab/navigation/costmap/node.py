@@ -196,6 +196,17 @@ class Costmap2DROS:
     def robot_base_frame(self) -> str:
         return self.params.robot_base_frame
 
+    @property
+    def ready(self) -> bool:
+        """Whether the master grid has been built from its inputs: updated at least once,
+        with every static layer's map received (ROS's Costmap2DROS does not start before
+        its static layer has a map)."""
+        if self.updates == 0 or not self.layered.initialized:
+            return False
+        return all(
+            layer.map_received for layer in self.layered.plugins if isinstance(layer, StaticLayer)
+        )
+
     def get_robot_pose(self) -> SE2 | None:
         """The robot's pose in ``global_frame`` (None, with a throttled message, when the
         transform is missing or older than ``transform_tolerance``)."""

@@ -356,6 +356,14 @@ class MoveBase(Node):
     def _make_plan(self, gpose: SE2 | None, now: float) -> bool:
         """Plan from the robot to the goal; True on success (the plan is then in use)."""
         assert self.goal is not None
+        if not self.global_costmap.ready:
+            # no plan on a costmap that has not got its map yet (an empty grid has no
+            # walls); patience starts once it has
+            self._throttle.warning(
+                "ready", "Waiting for the global costmap (its map) before planning"
+            )
+            self._last_valid_plan = now
+            return False
         if gpose is None:
             self._throttle.warning(
                 "start", "Unable to get starting pose of robot, unable to create global plan"
