@@ -5,7 +5,6 @@ from __future__ import annotations
 import math
 import signal
 import sys
-import threading
 import time
 from pathlib import Path
 from typing import Annotated, Any
@@ -13,13 +12,12 @@ from typing import Annotated, Any
 import numpy as np
 import typer
 
-from roverlab.actionlib import GoalStatus, SimpleActionClient, SimpleGoalState, status_name
 from roverlab.cli.common import connect_following_clock, network_options
 from roverlab.core import Context
-from roverlab.core.errors import GraphError
 from roverlab.description import find_package
-from roverlab.msgs import Twist, pose_from_xytheta
-from roverlab.navigation.patrol import PatrolError, PatrolSequence, PatrolStats, load_places
+from roverlab.msgs import Twist
+from roverlab.navigation.patrol import PatrolError, load_places
+from roverlab.navigation.patrol_client import Patroller
 
 
 def _default_locations() -> Path:
@@ -92,86 +90,41 @@ def _run(
 ) -> int:
     node = context.create_node("patrol")
     cmd_pub = node.create_publisher(Twist, "cmd_vel", 5)
-    client = SimpleActionClient(node, action, "move_base_msgs/MoveBaseAction")
-    context.spin_in_thread()
-    stop = threading.Event()
 
     def log(text: str) -> None:
         now = context.executor.clock_now_ns() / 1e9
         sys.stdout.write(f"[INFO] [{now:.6f}]: {text}\n")
         sys.stdout.flush()
 
+    patroller = Patroller(
+        node,
+        places,
+        frame,
+        rng=np.random.default_rng(seed),
+        rest_time=rest_time,
+        timeout=timeout,
+        log=log,
+        action=action,
+    )
+    context.spin_in_thread()
+
     def on_signal(signum: int, _frame: Any) -> None:
-        stop.set()
+        patroller.stop.set()
 
     old = {s: signal.signal(s, on_signal) for s in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)}
-    stats = PatrolStats()
     try:
-        log("Waiting for move_base action server...")
-        if not context.wait_for(
-            lambda: client.action_client.server_is_ready() or stop.is_set(), 60.0
-        ):
-            raise GraphError(f"no '{action}' action server within 60 s (is move_base running?)")
-        if stop.is_set():
-            return 1
-        log("Connected to move base server")
-        log("Starting navigation test")
-        sequence = PatrolSequence(places, np.random.default_rng(seed))
-        start = context.executor.clock_now_ns() / 1e9
-        prev = (0.0, 0.0)  # slam.py measures its first leg from the origin
-        while not stop.is_set() and (goals == 0 or stats.goals < goals):
-            place = sequence.next()
-            distance = math.hypot(place.x - prev[0], place.y - prev[1])
-            prev = (place.x, place.y)
-            stats.goals += 1
-            log(f"Going to: {place.name}")
-            pose = pose_from_xytheta(place.x, place.y, place.yaw)
-            goal = {"target_pose": {"header": {"frame_id": frame}, "pose": _plain(pose)}}
-            client.send_goal(goal)
-            context.wait_for(lambda: _finished(client) or stop.is_set(), timeout or None)
-            done = _finished(client)
-            if stop.is_set():
-                break
-            if not done:
-                client.cancel_goal()
-                log("Timed out achieving goal")
-            else:
-                state = client.get_state()
-                if state == GoalStatus.SUCCEEDED:
-                    log("Goal succeeded!")
-                    stats.successes += 1
-                    stats.distance_m += distance
-                    log(f"State:{state}")
-                else:
-                    log(f"Goal failed with error code: {status_name(state)}")
-            running = context.executor.clock_now_ns() / 1e9 - start
-            log(stats.success_line())
-            log(stats.time_line(running))
-            if rest_time > 0 and not stop.is_set() and (goals == 0 or stats.goals < goals):
-                context.wait_for(stop.is_set, rest_time)
+        patroller.wait_for_server()
+        if not patroller.stop.is_set():
+            patroller.run(goals)
     finally:
-        if stop.is_set():
-            log("Stopping the robot...")
-        client.cancel_goal()
-        cmd_pub.publish(Twist())
+        patroller.shutdown(lambda: cmd_pub.publish(Twist()))
         time.sleep(0.2)  # let the cancel and the zero Twist leave
         for s, handler in old.items():
             signal.signal(s, handler)
+    stats = patroller.stats
     typer.echo(
         f"patrol: {stats.successes}/{stats.goals} goals succeeded, "
         f"{stats.distance_m:.1f} m between the places reached",
         err=True,
     )
     return 0 if stats.goals and stats.successes == stats.goals else 1
-
-
-def _finished(client: SimpleActionClient) -> bool:
-    return client.simple_state == SimpleGoalState.DONE
-
-
-def _plain(pose: Any) -> dict[str, Any]:
-    p, q = pose.position, pose.orientation
-    return {
-        "position": {"x": p.x, "y": p.y, "z": p.z},
-        "orientation": {"x": q.x, "y": q.y, "z": q.z, "w": q.w},
-    }
