@@ -7,6 +7,7 @@ from typing import Annotated
 
 import typer
 
+from roverlab.bag import cli as bag_cli
 from roverlab.cli import (
     action,
     amcl_run,
@@ -63,6 +64,7 @@ slam_cli.app.command("mapeval")(slam_mapeval.mapeval)
 app.add_typer(slam_cli.app, name="slam")
 app.command("teleop")(teleop_cli.teleop)
 app.add_typer(amcl_run.app, name="amcl")
+app.add_typer(bag_cli.app, name="bag")
 
 
 @app.callback()
