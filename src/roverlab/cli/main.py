@@ -28,6 +28,7 @@ from roverlab.cli import (
 from roverlab.cli.common import NetworkOptions
 from roverlab.description import cli as urdf_cli
 from roverlab.errors import RoverlabError
+from roverlab.foxglove import cli as foxglove_cli
 from roverlab.maps import cli as map_cli
 from roverlab.slam import cli as slam_cli
 from roverlab.teleop import cli as teleop_cli
@@ -65,6 +66,7 @@ app.add_typer(slam_cli.app, name="slam")
 app.command("teleop")(teleop_cli.teleop)
 app.add_typer(amcl_run.app, name="amcl")
 app.add_typer(bag_cli.app, name="bag")
+app.command("foxglove")(foxglove_cli.foxglove)
 
 
 @app.callback()
