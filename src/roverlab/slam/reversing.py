@@ -24,6 +24,8 @@ __all__ = ["REVERSING_SPEED_M_S", "ReversingRepair"]
 
 #: ``tv`` below minus this (m/s) is reversing.
 REVERSING_SPEED_M_S: Final = 0.01
+# a step shorter than this (m) is no motion (a scan logged at the last ODOM pose)
+_NO_STEP_M: Final = 1e-9
 
 
 class ReversingRepair:
@@ -50,7 +52,7 @@ class ReversingRepair:
         if self._last is None or not self._reversing:
             return None
         step = ~self._last * pose
-        if step.x <= 0.0:
+        if step.x <= _NO_STEP_M:
             return None
         return self._apply(self._last) * SE2(-step.x, -step.y, step.theta)
 

@@ -90,6 +90,22 @@ def test_recovery_injects_random_particles_when_the_fast_average_drops() -> None
     assert pf.w_slow > 0 and pf.w_fast < pf.w_slow
 
 
+def test_product_likelihoods_are_averaged_per_beam() -> None:
+    """A product over 30 beams swings by orders of magnitude with what the laser sees; the
+    averages take its 30th root (the geometric mean pz per beam), given in log form."""
+    pf = _pf(alpha_slow=0.001, alpha_fast=0.1)
+    pf.init_gaussian((2.6, 2.1, 0.3), np.diag([1e-4, 1e-4, 1e-4]))
+    rng = np.random.default_rng(1)
+    for _ in range(200):  # well localised: log p per beam about log 0.8, +-20% per scan
+        log_p = 30 * math.log(0.8 * (1.0 + 0.2 * rng.uniform(-1, 1)))
+        pf.normalise(float(pf.weights.sum()), log_scale=log_p, beams=30)
+    assert pf.w_slow == pytest.approx(0.8, rel=0.05)
+    assert 1.0 - pf.w_fast / pf.w_slow < 0.15  # little injection while tracking
+    for _ in range(10):  # kidnapped: pz per beam 0.1
+        pf.normalise(float(pf.weights.sum()), log_scale=30 * math.log(0.1), beams=30)
+    assert 1.0 - pf.w_fast / pf.w_slow > 0.5
+
+
 def test_zero_rates_never_inject() -> None:
     pf = _pf()
     pf.init_gaussian((2.6, 2.1, 0.3), np.diag([1e-3, 1e-3, 1e-3]))

@@ -117,8 +117,11 @@ def likelihood_field_prob_weights(
     skip_threshold: float,
     skip_error_threshold: float,
     scratch: F64,
-) -> tuple[float, int, bool]:
-    """amcl's ``likelihood_field_prob`` model: ``w *= exp(sum_beams log pz)``.
+) -> tuple[float, float, int, bool]:
+    """amcl's ``likelihood_field_prob`` model: ``w *= exp(sum_beams log pz)``, computed in
+    the log domain: each particle's ``log p`` is found first and the weights are multiplied
+    by ``exp(log p - max log p)``, so that a product of many small ``pz`` does not
+    underflow to zero for every particle (amcl multiplies ``pz`` directly).
 
     With ``beamskip``, a beam is used only when more than ``skip_threshold`` of the
     particles see its end point within ``skip_distance`` of an obstacle; when at least
@@ -132,19 +135,20 @@ def likelihood_field_prob_weights(
         (others as :func:`likelihood_field_weights`)
 
     Returns:
-        ``(sum of weights, beams skipped, all beams used because too many disagreed)``.
+        ``(sum of weights, max log p, beams skipped, all beams used because too many
+        disagreed)``: the weights were multiplied by ``p / exp(max log p)``.
     """
     h, w = log_table.shape
     nb = ex.shape[0]
     n = poses.shape[0]
     agree = np.zeros(nb, dtype=np.int64)
-    total = 0.0
+    log_p = np.empty(n)
     for j in range(n):
         gx = (poses[j, 0] - ox) * inv_res
         gy = (poses[j, 1] - oy) * inv_res
         c = math.cos(poses[j, 2]) * inv_res
         s = math.sin(poses[j, 2]) * inv_res
-        log_p = 0.0
+        acc = 0.0
         for i in range(nb):
             hx = gx + c * ex[i] - s * ey[i]
             hy = gy + s * ex[i] + c * ey[i]
@@ -152,34 +156,41 @@ def likelihood_field_prob_weights(
                 r = int(hy)
                 q = int(hx)
                 v = log_table[r, q]
-                if distance[r, q] < skip_distance:
+                if beamskip and distance[r, q] < skip_distance:
                     agree[i] += 1
             else:
                 v = off_map
             if beamskip:
                 scratch[j, i] = v
             else:
-                log_p += v
-        if not beamskip:
-            weights[j] *= math.exp(log_p)
-            total += weights[j]
-    if not beamskip:
-        return total, 0, False
-    use = np.empty(nb, dtype=np.bool_)
+                acc += v
+        log_p[j] = acc
     skipped = 0
-    for i in range(nb):
-        use[i] = agree[i] / n > skip_threshold
-        if not use[i]:
-            skipped += 1
-    too_many = skipped >= nb * skip_error_threshold
-    for j in range(n):
-        log_p = 0.0
+    too_many = False
+    if beamskip:
+        use = np.empty(nb, dtype=np.bool_)
         for i in range(nb):
-            if too_many or use[i]:
-                log_p += scratch[j, i]
-        weights[j] *= math.exp(log_p)
+            use[i] = agree[i] / n > skip_threshold
+            if not use[i]:
+                skipped += 1
+        too_many = skipped >= nb * skip_error_threshold
+        for j in range(n):
+            acc = 0.0
+            for i in range(nb):
+                if too_many or use[i]:
+                    acc += scratch[j, i]
+            log_p[j] = acc
+    top = 0.0
+    found = False
+    for j in range(n):
+        if weights[j] > 0.0 and (not found or log_p[j] > top):
+            top = log_p[j]
+            found = True
+    total = 0.0
+    for j in range(n):
+        weights[j] *= math.exp(log_p[j] - top)
         total += weights[j]
-    return total, (0 if too_many else skipped), too_many
+    return total, top, (0 if too_many else skipped), too_many
 
 
 @_jit
