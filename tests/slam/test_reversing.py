@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 from pathlib import Path
 
@@ -29,7 +30,7 @@ def _true_path() -> list[tuple[SE2, float]]:
 def _as_logged(path: list[tuple[SE2, float]]) -> list[SE2]:
     """What the faulty base logs: every step's translation taken forward (|tv|)."""
     logged = [path[0][0]]
-    for (a, _), (b, _) in zip(path, path[1:], strict=False):
+    for (a, _), (b, _) in itertools.pairwise(path):
         step = ~a * b
         if step.x < 0.0:
             step = SE2(-step.x, -step.y, step.theta)

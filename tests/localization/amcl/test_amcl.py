@@ -114,8 +114,10 @@ def test_tracking_a_drive_from_an_offset_start() -> None:
         {"do_beamskip": True},
         {"odom_model_type": "diff"},
         {  # ROS 1 amcl's defaults
-            "laser_model_type": "likelihood_field", "laser_sigma_hit": 0.2,
-            "odom_model_type": "diff", "resample_interval": 2,
+            "laser_model_type": "likelihood_field",
+            "laser_sigma_hit": 0.2,
+            "odom_model_type": "diff",
+            "resample_interval": 2,
         },
         {"odom_model_type": "omni"},
         {"odom_model_type": "omni-corrected"},

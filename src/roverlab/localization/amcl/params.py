@@ -24,10 +24,10 @@ from roverlab.localization.amcl.errors import AmclParamsError
 
 __all__ = [
     "IGNORED_PARAMETERS",
-    "MODEL_DEFAULT",
-    "ODOM_ALPHA_DEFAULTS",
     "LASER_MODELS",
+    "MODEL_DEFAULT",
     "NODE_PARAMETERS",
+    "ODOM_ALPHA_DEFAULTS",
     "ODOM_MODELS",
     "AmclParams",
 ]
