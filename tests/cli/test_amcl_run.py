@@ -124,8 +124,10 @@ def test_odometry_steps_logged_forward_while_reversing_are_reversed(tmp_path: Pa
     args = ["amcl", "run", str(log), "--map", str(_free_map(tmp_path)), "--initial", "0,0,0"]
     r = _cli(*args, "--out", str(tmp_path / "a"))
     assert r.returncode == 0, r.stderr
-    assert ("odometry: 10 of 29 steps moved forward while the velocity was negative "
-            "(reversing); they were reversed (--logged-odometry: as logged)") in r.stderr
+    assert (
+        "odometry: 10 of 29 steps moved forward while the velocity was negative "
+        "(reversing); they were reversed (--logged-odometry: as logged)"
+    ) in r.stderr
     fixed = np.loadtxt(tmp_path / "a" / "trajectory.tum")
     raw = _cli(*args, "--out", str(tmp_path / "b"), "--logged-odometry")
     assert raw.returncode == 0 and "odometry:" not in raw.stderr
