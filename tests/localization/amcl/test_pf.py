@@ -158,6 +158,37 @@ def test_clusters_and_convergence() -> None:
     assert pf.converged
 
 
+def _root(parent: list[int], i: int) -> int:
+    while parent[i] != i:
+        i = parent[i]
+    return i
+
+
+def test_clusters_join_touching_bins_as_a_brute_force_reference() -> None:
+    rng = np.random.default_rng(7)
+    for n, side in ((80, 12.0), (2000, 30.0)):
+        poses = np.column_stack([rng.uniform(0, side, n), rng.uniform(0, side, n),
+                                 rng.uniform(-math.pi, math.pi, n)])  # fmt: skip
+        pf = _pf()
+        pf.poses = poses
+        pf.weights = np.full(n, 1 / n)
+        labels = pf.clusters().labels
+        ix = np.floor(poses[:, 0] / 0.5).astype(int)
+        iy = np.floor(poses[:, 1] / 0.5).astype(int)
+        ia = np.floor((poses[:, 2] + math.pi) / math.radians(10.0)).astype(int) % 36
+        parent = list(range(n))
+
+        da = np.abs(ia[:, None] - ia[None, :])
+        touch = ((np.abs(ix[:, None] - ix[None, :]) <= 1) & (np.abs(iy[:, None] - iy[None, :]) <= 1)
+                 & (np.minimum(da, 36 - da) <= 1))  # fmt: skip
+        for i, j in zip(*np.nonzero(touch), strict=True):
+            parent[_root(parent, int(i))] = _root(parent, int(j))
+        ref = np.array([_root(parent, i) for i in range(n)])
+        same = ref[:, None] == ref[None, :]
+        assert np.array_equal(same, labels[:, None] == labels[None, :])
+        assert len(set(labels.tolist())) == len(set(ref.tolist())) > 5
+
+
 def test_seeded_filters_repeat_and_different_seeds_differ() -> None:
     def run(seed: int) -> np.ndarray:
         pf = _pf(seed, alpha_slow=0.001, alpha_fast=0.1)

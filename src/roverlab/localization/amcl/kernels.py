@@ -1,4 +1,5 @@
-"""amcl's compiled kernels: motion models, particle weighting, KLD resampling, clusters.
+"""amcl's compiled kernels: motion models, particle weighting, KLD resampling (clusters:
+:mod:`.clusters`).
 
 Every kernel is ``numba.njit(cache=True, nogil=True)`` over plain arrays; kernels that
 draw take the caller's ``np.random.Generator`` (numba draws from its state, the same
@@ -27,7 +28,6 @@ __all__ = [
     "BIN_ANGLE_RAD",
     "BIN_XY_M",
     "beam_weights",
-    "cluster_stats",
     "diff_motion",
     "kld_resample",
     "likelihood_field_prob_weights",
@@ -423,120 +423,3 @@ def omni_motion(
 @_jit
 def _wrap(a: float) -> float:
     return (a + math.pi) % (2.0 * math.pi) - math.pi
-
-
-@_jit
-def cluster_stats(
-    poses: F64, weights: F64
-) -> tuple[I64, F64, F64, F64, NDArray[np.int64], F64, F64]:
-    """amcl's ``pf_cluster_stats``: histogram bins joined into clusters by adjacency (the
-    26 neighbouring bins), then each cluster's weight, mean and covariance.
-
-    Means of yaw are circular (``atan2`` of the weighted sines and cosines) and the yaw
-    variance is ``-2 log R`` (``R``: the mean resultant length of the cluster's weights).
-
-    Returns:
-        ``(labels (N,), weight (C,), mean (C, 3), cov (C, 3, 3), count (C,),
-        set mean (3,), set cov (3, 3))``.
-    """
-    n = poses.shape[0]
-    keys = np.empty(n, dtype=np.int64)
-    for j in range(n):
-        keys[j] = _bin_key(poses[j, 0], poses[j, 1], poses[j, 2])
-    order = np.argsort(keys)
-    uniq = np.empty(n, dtype=np.int64)
-    of_particle = np.empty(n, dtype=np.int64)
-    nu = 0
-    for r in range(n):
-        j = order[r]
-        if nu == 0 or keys[j] != uniq[nu - 1]:
-            uniq[nu] = keys[j]
-            nu += 1
-        of_particle[j] = nu - 1
-    uniq = uniq[:nu]
-    label = np.full(nu, -1, dtype=np.int64)
-    stack = np.empty(nu, dtype=np.int64)
-    clusters = 0
-    for b in range(nu):
-        if label[b] >= 0:
-            continue
-        label[b] = clusters
-        top = 0
-        stack[top] = b
-        top += 1
-        while top > 0:
-            top -= 1
-            cur = uniq[stack[top]]
-            kx = cur >> 42
-            ky = (cur >> 21) & _MASK
-            ka = cur & _MASK
-            for dx in range(-1, 2):
-                for dy in range(-1, 2):
-                    for da in range(-1, 2):
-                        if dx == 0 and dy == 0 and da == 0:
-                            continue
-                        na = (ka + da) % ANGLE_BINS
-                        nk = ((kx + dx) << 42) | ((ky + dy) << 21) | na
-                        pos = np.searchsorted(uniq, nk)
-                        if pos < nu and uniq[pos] == nk and label[pos] < 0:
-                            label[pos] = clusters
-                            stack[top] = pos
-                            top += 1
-        clusters += 1
-    labels = np.empty(n, dtype=np.int64)
-    cw = np.zeros(clusters)
-    count = np.zeros(clusters, dtype=np.int64)
-    m = np.zeros((clusters, 4))
-    cc = np.zeros((clusters, 2, 2))
-    sm = np.zeros(4)
-    sc = np.zeros((2, 2))
-    total = 0.0
-    for j in range(n):
-        c = label[of_particle[j]]
-        labels[j] = c
-        wj = weights[j]
-        x = poses[j, 0]
-        y = poses[j, 1]
-        ca = math.cos(poses[j, 2])
-        sa = math.sin(poses[j, 2])
-        count[c] += 1
-        cw[c] += wj
-        total += wj
-        m[c, 0] += wj * x
-        m[c, 1] += wj * y
-        m[c, 2] += wj * ca
-        m[c, 3] += wj * sa
-        sm[0] += wj * x
-        sm[1] += wj * y
-        sm[2] += wj * ca
-        sm[3] += wj * sa
-        cc[c, 0, 0] += wj * x * x
-        cc[c, 0, 1] += wj * x * y
-        cc[c, 1, 1] += wj * y * y
-        sc[0, 0] += wj * x * x
-        sc[0, 1] += wj * x * y
-        sc[1, 1] += wj * y * y
-    mean = np.zeros((clusters, 3))
-    cov = np.zeros((clusters, 3, 3))
-    for c in range(clusters):
-        if cw[c] <= 0.0:
-            continue
-        _moments(m[c], cc[c], cw[c], mean[c], cov[c])
-    set_mean = np.zeros(3)
-    set_cov = np.zeros((3, 3))
-    if total > 0.0:
-        _moments(sm, sc, total, set_mean, set_cov)
-    return labels, cw, mean, cov, count, set_mean, set_cov
-
-
-@_jit
-def _moments(m: F64, c: F64, w: float, mean: F64, cov: F64) -> None:
-    mean[0] = m[0] / w
-    mean[1] = m[1] / w
-    mean[2] = math.atan2(m[3], m[2])
-    cov[0, 0] = c[0, 0] / w - mean[0] * mean[0]
-    cov[0, 1] = c[0, 1] / w - mean[0] * mean[1]
-    cov[1, 0] = cov[0, 1]
-    cov[1, 1] = c[1, 1] / w - mean[1] * mean[1]
-    resultant = math.sqrt(m[2] * m[2] + m[3] * m[3]) / w
-    cov[2, 2] = -2.0 * math.log(resultant) if resultant > 0.0 else math.inf

@@ -14,9 +14,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from roverlab.localization.amcl.clusters import cluster_stats, max_spread
 from roverlab.localization.amcl.errors import AmclInputError, AmclParamsError
 from roverlab.localization.amcl.field import AmclMap
-from roverlab.localization.amcl.kernels import cluster_stats, kld_resample
+from roverlab.localization.amcl.kernels import kld_resample
 
 __all__ = ["Clusters", "ParticleFilter", "kld_limits"]
 
@@ -290,9 +291,7 @@ class ParticleFilter:
         self._update_converged()
 
     def _update_converged(self) -> None:
-        centre = self.poses[:, :2].mean(axis=0)
-        spread = np.abs(self.poses[:, :2] - centre).max(initial=0.0)
-        self.converged = bool(spread <= CONVERGED_DISTANCE_M)
+        self.converged = bool(max_spread(self.poses) <= CONVERGED_DISTANCE_M)
 
     # ------------------------------------------------------------------ statistics
     def clusters(self) -> Clusters:
