@@ -6,7 +6,11 @@ Prints:
 - in-process 720-beam LaserScan publish -> callback rate (target >= 200,000 msg/s);
 - Zenoh two-process round trip of a 720-beam LaserScan, median and p99 (target median
   <= 1 ms);
-- Zenoh two-process throughput of 720-beam LaserScans (target >= 20,000 scans/s).
+- Zenoh two-process throughput of 720-beam LaserScans (target >= 20,000 scans/s);
+- service round trips (rospy_tutorials/AddTwoInts): in process, through the executor
+  (call_async completed by the executor; target >= 20,000 calls/s) and inline (``call``
+  while nothing spins), and across two processes over Zenoh, median and p99 of ``call``
+  (target median <= 1 ms).
 The second process is this script run with ``--child``.
 """
 
@@ -69,6 +73,31 @@ def bench_inprocess(n: int) -> float:
     return got[0] / dt
 
 
+def _add(req: Any, resp: Any) -> Any:
+    resp.sum = req.a + req.b
+    return resp
+
+
+def bench_service_inprocess(n: int) -> tuple[float, float]:
+    """Calls per second: call_async + the executor completing it, and inline call()."""
+    ctx = Context(publish_clock=False)
+    ctx.create_node("server").create_service("rospy_tutorials/AddTwoInts", "/add", _add)
+    client = ctx.create_node("client").create_client("rospy_tutorials/AddTwoInts", "/add")
+    req = client.srv_type.Request(a=1, b=2)
+    t0 = time.perf_counter()
+    for _ in range(n):
+        future = client.call_async(req)
+        ctx.spin_until_future_complete(future)
+        assert future.result().sum == 3
+    executor_rate = n / (time.perf_counter() - t0)
+    t0 = time.perf_counter()
+    for _ in range(n):
+        client.call(req)
+    inline_rate = n / (time.perf_counter() - t0)
+    ctx.shutdown()
+    return executor_rate, inline_rate
+
+
 def _options(endpoint: str) -> ZenohOptions:
     return ZenohOptions(listen=("tcp/127.0.0.1:0",), connect=(endpoint,))
 
@@ -89,13 +118,16 @@ def child(endpoint: str) -> None:
             count[0] = 0
 
     node.create_subscription(LaserScan, "/flood", on_flood, 100000)
+    node.create_service("rospy_tutorials/AddTwoInts", "/add_two_ints", _add)
     ctx.add_transport(ZenohTransport(_options(endpoint)))
     print("READY", flush=True)
     with contextlib.suppress(KeyboardInterrupt):
         ctx.spin()
 
 
-def bench_zenoh(endpoint: str, pings: int, scans: int) -> tuple[float, float, float, int]:
+def bench_zenoh(
+    endpoint: str, pings: int, scans: int
+) -> tuple[float, float, float, int, float, float]:
     proc = subprocess.Popen(
         [sys.executable, __file__, "--child", "--endpoint", endpoint],
         stdout=subprocess.PIPE,
@@ -113,6 +145,7 @@ def bench_zenoh(endpoint: str, pings: int, scans: int) -> tuple[float, float, fl
         counts: list[int] = []
         node.create_subscription(LaserScan, "/pong", lambda m: got.append(m.header.stamp.sec), 1000)
         node.create_subscription(String, "/flood_count", lambda m: counts.append(int(m.data)), 10)
+        client = node.create_client("rospy_tutorials/AddTwoInts", "/add_two_ints")
         ctx.add_transport(ZenohTransport(_options(endpoint)))
         deadline = time.monotonic() + 10
         while (
@@ -141,9 +174,26 @@ def bench_zenoh(endpoint: str, pings: int, scans: int) -> tuple[float, float, fl
         ctx.spin_until_condition(lambda: bool(counts), timeout_sec=60)
         dt = time.perf_counter() - t0
         received = counts[0] if counts else 0
+        if not client.wait_for_service(timeout_sec=10):
+            raise RuntimeError("the benchmark child's service did not appear")
+        req = client.srv_type.Request(a=1, b=2)
+        calls: list[float] = []
+        for i in range(pings + 50):
+            t0 = time.perf_counter()
+            assert client.call(req, timeout_sec=5).sum == 3
+            if i >= 50:
+                calls.append(time.perf_counter() - t0)
         ctx.shutdown()
         a = np.asarray(rtts) * 1e3
-        return float(np.median(a)), float(np.percentile(a, 99)), received / dt, received
+        c = np.asarray(calls) * 1e3
+        return (
+            float(np.median(a)),
+            float(np.percentile(a, 99)),
+            received / dt,
+            received,
+            float(np.median(c)),
+            float(np.percentile(c, 99)),
+        )
     finally:
         proc.terminate()
         proc.wait(timeout=5)
@@ -160,6 +210,7 @@ def main() -> None:
     parser.add_argument("--messages", type=int, default=500_000)
     parser.add_argument("--pings", type=int, default=2000)
     parser.add_argument("--scans", type=int, default=50_000)
+    parser.add_argument("--calls", type=int, default=100_000)
     parser.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
     parser.add_argument("--endpoint", default=None, help=argparse.SUPPRESS)
     args = parser.parse_args()
@@ -172,11 +223,16 @@ def main() -> None:
     )
     rate = bench_inprocess(args.messages)
     print(f"in-process LaserScan(720) publish->callback: {rate:,.0f} msg/s (target >= 200,000)")
+    srv_rate, inline_rate = bench_service_inprocess(args.calls)
+    print(
+        f"in-process service call (call_async, completed by the executor): {srv_rate:,.0f} "
+        f"calls/s (target >= 20,000); inline call(): {inline_rate:,.0f} calls/s"
+    )
     endpoint = f"tcp/127.0.0.1:{_free_port()}"
     os.environ["ROVERLAB_DAEMON"] = endpoint
     ensure_daemon(endpoint)
     try:
-        med, p99, tput, received = bench_zenoh(endpoint, args.pings, args.scans)
+        med, p99, tput, received, s_med, s_p99 = bench_zenoh(endpoint, args.pings, args.scans)
     finally:
         stop_daemon(endpoint)
     print(
@@ -186,6 +242,10 @@ def main() -> None:
     print(
         f"zenoh 2-process LaserScan(720) throughput: {tput:,.0f} scans/s "
         f"({received}/{args.scans} delivered; target >= 20,000)"
+    )
+    print(
+        f"zenoh 2-process service call round trip: median {s_med:.3f} ms, p99 {s_p99:.3f} ms "
+        f"({1000 / s_med:,.0f} calls/s sequential; target median <= 1 ms)"
     )
 
 

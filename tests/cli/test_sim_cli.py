@@ -91,3 +91,49 @@ def test_bad_input_is_one_line_exit_2(args: list[str], needle: str, tmp_path: Pa
     lines = r.stderr.strip().splitlines()
     assert len(lines) == 1 and needle in lines[0], r.stderr
     assert not out.exists() and not (tmp_path / "x.mcap.part").exists()
+
+
+@pytest.mark.zenoh
+def test_rate_max_runs_privately_by_default(daemon: str, tmp_path: Path) -> None:
+    """A batch run neither feeds nor hears another system on the machine."""
+    import threading
+    import time
+
+    from roverlab.core import Context
+    from roverlab.core.transport.daemon import connect_context
+    from roverlab.msgs import Twist
+
+    outsider = Context(clock="wall")
+    node = outsider.create_node("outsider")
+    clocks: list[Any] = []
+    node.create_subscription("rosgraph_msgs/Clock", "/clock", clocks.append, 100)
+    cmd = node.create_publisher("geometry_msgs/Twist", "/cmd_vel", 10)
+    connect_context(outsider)
+    outsider.spin_in_thread()
+    stop = threading.Event()
+
+    def drive() -> None:  # an operator's teleop running on the same machine
+        while not stop.is_set():
+            cmd.publish(Twist(linear_x=0.5))
+            time.sleep(0.05)
+
+    driver = threading.Thread(target=drive, daemon=True)
+    driver.start()
+    out = tmp_path / "batch.mcap"
+    try:
+        r = subprocess.run(
+            [sys.executable, "-m", "roverlab.cli", "sim", "--rate", "max", "--duration", "20",
+             "--record", str(out)],
+            capture_output=True, text=True, timeout=300,
+        )  # fmt: skip
+    finally:
+        stop.set()
+        driver.join()
+        outsider.shutdown()
+    assert r.returncode == 0, r.stderr
+    assert "--rate max runs privately" in r.stderr
+    assert clocks == []  # its /clock never reached the outsider
+    counts, msgs = _read(out)
+    assert counts["/cmd_vel"] == 0  # and the outsider's commands never reached it
+    last = msgs["/odom"][-1].pose.pose.position
+    assert math.hypot(last.x, last.y) < 1e-9

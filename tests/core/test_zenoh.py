@@ -194,3 +194,19 @@ def test_service_call_across_processes(node_proc: Any) -> None:
         assert ("/fail", "std_srvs/srv/Trigger") in services
     finally:
         ctx.shutdown()
+
+
+def test_a_second_clock_source_is_warned_about(
+    node_proc: Any, caplog: pytest.LogCaptureFixture
+) -> None:
+    node_proc("clock")  # a paced simulation publishing /clock elsewhere on the machine
+    ctx = Context(clock="paced", rate=1.0)  # this process publishes /clock too
+    with caplog.at_level("WARNING", logger="roverlab"):
+        connect_context(ctx)
+        ctx.spin_in_thread()
+        try:
+            assert _wait(lambda: "a second /clock source" in caplog.text, timeout=10)
+        finally:
+            ctx.shutdown()
+    assert "/proc_clock" in caplog.text or "/clock_publisher" in caplog.text
+    assert "ROVERLAB_DOMAIN_ID" in caplog.text

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, replace
 from typing import Any
@@ -17,7 +18,7 @@ from roverlab.core.transport.zenoh import (
     query_graph,
 )
 
-__all__ = ["Connection", "NetworkOptions", "network_options", "run_context"]
+__all__ = ["Connection", "NetworkOptions", "choose_expose", "network_options", "run_context"]
 
 _SETTLE_S = 0.3
 
@@ -100,3 +101,19 @@ def run_context(context: Context, duration_s: float | None) -> float:
     finally:
         context.shutdown()
     return time.monotonic() - started
+
+
+def choose_expose(expose: bool | None, pace: float) -> bool:
+    """Whether a run joins the network: as asked, else yes for a paced run and no for
+    ``--rate max`` (a batch run must neither feed nor hear another system on the machine:
+    its sim time would mix with theirs)."""
+    if expose is not None:
+        return expose
+    if math.isinf(pace):
+        typer.echo(
+            "note: --rate max runs privately (other processes neither see nor feed it); "
+            "--expose to attach",
+            err=True,
+        )
+        return False
+    return True

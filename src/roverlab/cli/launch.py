@@ -9,7 +9,7 @@ from typing import Annotated
 import typer
 
 from roverlab.bag import McapRecorder
-from roverlab.cli.common import network_options, run_context
+from roverlab.cli.common import choose_expose, network_options, run_context
 from roverlab.cli.sim import parse_rate
 from roverlab.core import Context, configure_logging
 from roverlab.core.transport.zenoh import ZenohTransport
@@ -82,9 +82,13 @@ def launch(
         Path | None, typer.Option("--record", help="Record every topic to this MCAP file.")
     ] = None,
     expose: Annotated[
-        bool,
-        typer.Option("--expose/--no-expose", help="Make the topics visible to other processes."),
-    ] = True,
+        bool | None,
+        typer.Option(
+            "--expose/--no-expose",
+            help="Make the topics visible to other processes. Default: yes, except at "
+            "--rate max, which runs privately.",
+        ),
+    ] = None,
     clock: Annotated[
         str,
         typer.Option(
@@ -110,7 +114,7 @@ def launch(
             recorder = McapRecorder(record)
             context.add_transport(recorder)
         started = build_launch(spec, context=context, seed=seed)
-        if expose:
+        if choose_expose(expose, pace):
             context.add_transport(ZenohTransport(network_options(ctx).zenoh_options()))
     except BaseException:
         if recorder is not None:

@@ -15,7 +15,6 @@ from roverlab.core.transport.zenoh import ZenohTransport, query_graph
 from roverlab.description import find_package
 from roverlab.description.errors import DescriptionError
 from roverlab.errors import RoverlabError
-from roverlab.launch import LaunchError
 from roverlab.launch.registry import REGISTRY, LaunchState
 from roverlab.launch.xml import NodeSpec
 from roverlab.ros1 import run_script
@@ -114,7 +113,7 @@ def run(
     if note:
         typer.echo(f"note: {note}", err=True)
     context = Context(clock=mode, publish_clock=False)
-    context.add_transport(transport)
+    context.add_transport(transport)  # the context closes it on shutdown
     if script is not None:
         try:
             code = run_script(script, rest, context)
@@ -129,7 +128,7 @@ def run(
         node: Node | None = REGISTRY[(spec.pkg, spec.type)](
             LaunchState(context=context, params={}), spec
         )
-    except LaunchError:
+    except BaseException:
         context.shutdown()
         raise
     if node is not None:

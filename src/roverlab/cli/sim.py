@@ -9,7 +9,7 @@ from typing import Annotated
 import typer
 
 from roverlab.bag import McapRecorder
-from roverlab.cli.common import network_options, run_context
+from roverlab.cli.common import choose_expose, network_options, run_context
 from roverlab.core import Context, configure_logging
 from roverlab.core.transport.zenoh import ZenohTransport
 from roverlab.sim.app import Simulation, SimulationError
@@ -82,12 +82,13 @@ def sim(
         typer.Option("--arg", help="xacro argument name:=value (repeatable)."),
     ] = None,
     expose: Annotated[
-        bool,
+        bool | None,
         typer.Option(
             "--expose/--no-expose",
-            help="Make the topics visible to other processes (roverlab topic echo, teleop).",
+            help="Make the topics visible to other processes (roverlab topic echo, teleop). "
+            "Default: yes, except at --rate max, which runs privately.",
         ),
-    ] = True,
+    ] = None,
     dashboard: Annotated[
         bool,
         typer.Option("--dashboard", help="Serve the web dashboard (rviz) from this process."),
@@ -117,7 +118,7 @@ def sim(
             seed=seed,
             robot_args=parse_args(arg),
         )
-        if expose:
+        if choose_expose(expose, pace):
             context.add_transport(ZenohTransport(network_options(ctx).zenoh_options()))
     except BaseException:
         if recorder is not None:

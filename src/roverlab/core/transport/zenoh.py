@@ -205,6 +205,8 @@ class ZenohTransport:
         self.sent = 0
         self.dropped_wrong_type = 0
         self._services = ZenohServices(self)
+        self._clock_watch: Any = None
+        self._clock_sources: dict[str, str] = {}  # zid -> node of other /clock publishers
 
     @property
     def context(self) -> Context | None:
@@ -240,7 +242,42 @@ class ZenohTransport:
                 for ent in self._node_entities.pop(fq, []):
                     ent.undeclare()
 
+    def _watch_clock(self) -> None:
+        """Warn when another process publishes /clock on this domain while this one
+        publishes or follows it: two clocks would mix silently (a batch run picking up a
+        simulator's time, or a node seeing time jump between two simulations)."""
+        if self._clock_watch is not None:
+            return
+        pattern = f"rl/{self.domain}/g/*/p/*/{encode_name('/clock')}/**"
+
+        def on_token(sample: Any) -> None:
+            ent = parse_graph_key(str(sample.key_expr))
+            if ent is None or ent.zid == self.zid:
+                return
+            if sample.kind != zenoh.SampleKind.PUT:
+                self._clock_sources.pop(ent.zid, None)
+                return
+            ctx = self._context
+            if ent.zid in self._clock_sources or ctx is None:
+                return
+            self._clock_sources[ent.zid] = ent.node
+            topic = ctx.graph.topics.get("/clock")
+            publishes = topic is not None and bool(topic.publishers)
+            if publishes or len(self._clock_sources) > 1:
+                others = ", ".join(sorted(set(self._clock_sources.values())))
+                ctx._logger.warning(
+                    f"a second /clock source on domain {self.domain}: {others} in another "
+                    f"process{' besides this one' if publishes else ''}; their times mix. "
+                    "Stop one, or give each run its own ROVERLAB_DOMAIN_ID"
+                )
+
+        self._clock_watch = self.session.liveliness().declare_subscriber(
+            pattern, on_token, history=True
+        )
+
     def on_publisher(self, pub: Publisher, added: bool) -> None:
+        if added and pub.topic.name == "/clock":
+            self._watch_clock()
         topic = pub.topic
         with self._lock:
             link = self._link(topic.name)
@@ -274,6 +311,8 @@ class ZenohTransport:
                     link.latched_queryable = None
 
     def on_subscription(self, sub: Subscription, added: bool) -> None:
+        if added and sub.topic.name == "/clock":
+            self._watch_clock()
         topic = sub.topic
         with self._lock:
             link = self._link(topic.name)
@@ -319,6 +358,7 @@ class ZenohTransport:
 
     def close(self) -> None:
         self._services.close()
+        self._clock_watch = None
         with self._lock:
             self._links.clear()
             self._node_entities.clear()

@@ -1,0 +1,92 @@
+"""``roverlab run``: a registry node (rosrun), a script found in a package, bad targets."""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+import yaml
+
+from roverlab.maps import save_map
+from tests.helpers.procs import Proc
+
+pytestmark = pytest.mark.zenoh
+
+
+def test_run_registry_node_serves_static_map(cli: Any, tmp_path: Path) -> None:
+    grid = np.zeros((20, 30), np.int8)
+    grid[5, :] = 100
+    saved = save_map(tmp_path / "room", grid, resolution=0.1, origin=(-1.0, -1.0, 0.0))
+    server = Proc(
+        [
+            sys.executable,
+            "-m",
+            "roverlab.cli",
+            "run",
+            "map_server",
+            "map_server",
+            str(saved.yaml_path),
+            "__name:=my_map_server",
+            "_frame_id:=world",
+        ]
+    )
+    try:
+        r = cli("service", "call", "/static_map", "nav_msgs/GetMap", "--timeout", "15")
+        assert r.returncode == 0, r.stderr
+        reply = yaml.safe_load(r.stdout.split("response:")[1])
+        info = reply["map"]["info"]
+        assert (info["width"], info["height"]) == (30, 20)
+        assert reply["map"]["header"]["frame_id"] == "world"
+        r = cli("node", "list")
+        assert "/my_map_server" in r.stdout.split()
+    finally:
+        server.stop()
+
+
+def test_run_script_from_a_package(
+    cli: Any, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    pkg = tmp_path / "ws" / "hello_pkg"
+    (pkg / "scripts").mkdir(parents=True)
+    (pkg / "package.xml").write_text("<package><name>hello_pkg</name></package>")
+    (pkg / "scripts" / "hello.py").write_text(
+        "import rospy\n"
+        "rospy.init_node('hello')\n"
+        "rospy.loginfo('hello from %s with %s', rospy.get_name(), rospy.get_param('~who'))\n"
+    )
+    monkeypatch.setenv("ROVERLAB_PACKAGE_PATH", str(tmp_path / "ws"))
+    r = cli("run", "--clock", "wall", "hello_pkg", "hello.py", "_who:=ros")
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.strip().endswith("]: hello from /hello with ros")
+
+
+@pytest.mark.parametrize(
+    ("args", "needle"),
+    [
+        (["no_such_script.py"], "no_such_script.py: no such file"),
+        (["no_such_pkg", "thing"], "not a roverlab node, and"),
+        (["mbot_navigation", "nothing.py"], "no file 'nothing.py' in package mbot_navigation"),
+        (["--clock", "sometimes", "map_server", "map_server", "x.yaml"], "unknown --clock"),
+    ],
+)
+def test_run_bad_targets_are_one_line_exit_2(cli: Any, args: list[str], needle: str) -> None:
+    r = cli("run", *args)
+    assert r.returncode == 2
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and needle in lines[0], r.stderr
+
+
+def test_run_map_server_bad_map_is_one_line(cli: Any, tmp_path: Path) -> None:
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(
+        "image: missing.pgm\nresolution: 0.05\norigin: [0, 0, 0]\nnegate: 0\n"
+        "occupied_thresh: 0.65\nfree_thresh: 0.196\n"
+    )
+    r = cli("run", "map_server", "map_server", str(bad))
+    assert r.returncode == 2
+    assert len(r.stderr.strip().splitlines()) == 1 and "missing.pgm" in r.stderr
+    assert os.path.exists(bad)
