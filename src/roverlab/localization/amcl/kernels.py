@@ -422,4 +422,8 @@ def omni_motion(
 
 @_jit
 def _wrap(a: float) -> float:
+    """``a`` in ``[-pi, pi)`` (as it is when it already lies there: no floating-point
+    modulo on the common path)."""
+    if -math.pi <= a < math.pi:
+        return a
     return (a + math.pi) % (2.0 * math.pi) - math.pi
