@@ -5,7 +5,7 @@ velocity ``tv``. Some bases integrate the speed without its sign: while ``tv`` i
 (reversing) the logged pose still advances along the heading, so the odometry moves the
 robot forwards when it drives backwards (the headings are right). In Freiburg's fr079 log
 416 of 8,950 steps do this, and the log's ground-truth relations confirm the backward
-motion; no step of a log does the opposite.
+motion; no step of fr079 or intel goes backwards while ``tv`` is positive.
 
 :class:`ReversingRepair` re-integrates such a pose stream: a step whose forward component
 disagrees with a negative ``tv`` is reversed (its translation in the previous pose's frame
