@@ -10,6 +10,7 @@ from typing import Any
 import typer
 
 from roverlab.core import Context
+from roverlab.core.errors import TransportError
 from roverlab.core.transport.daemon import ensure_daemon
 from roverlab.core.transport.zenoh import (
     GraphEntity,
@@ -18,7 +19,18 @@ from roverlab.core.transport.zenoh import (
     query_graph,
 )
 
-__all__ = ["Connection", "NetworkOptions", "choose_expose", "network_options", "run_context"]
+__all__ = [
+    "FOLLOWER_CLOCKS",
+    "Connection",
+    "NetworkOptions",
+    "choose_expose",
+    "connect_following_clock",
+    "network_options",
+    "run_context",
+]
+
+#: ``--clock`` of commands that join a running system (``roverlab run``, ``patrol``).
+FOLLOWER_CLOCKS = ("auto", "wall", "external")
 
 _SETTLE_S = 0.3
 
@@ -117,3 +129,26 @@ def choose_expose(expose: bool | None, pace: float) -> bool:
         )
         return False
     return True
+
+
+def connect_following_clock(options: NetworkOptions, clock: str) -> tuple[ZenohTransport, str, str]:
+    """The transport, and the clock mode (``auto``: follow /clock when someone publishes
+    it, as a ROS node with /use_sim_time does next to a simulator; else wall time)."""
+    if clock not in FOLLOWER_CLOCKS:
+        raise TransportError(f"unknown --clock {clock!r} ({', '.join(FOLLOWER_CLOCKS)})")
+    transport = ZenohTransport(options.zenoh_options())
+    if clock != "auto":
+        return transport, clock, ""
+    time.sleep(0.3)  # the router's declarations reach a fresh session first
+    deadline = time.monotonic() + 1.0
+    while True:
+        clocks = [
+            e
+            for e in query_graph(transport.session, transport.domain, 0.5)
+            if e.kind == "publisher" and e.topic == "/clock"
+        ]
+        if clocks:
+            return transport, "external", f"following /clock from {clocks[0].node} (sim time)"
+        if time.monotonic() >= deadline:
+            return transport, "wall", ""
+        time.sleep(0.2)

@@ -14,6 +14,7 @@ from roverlab.cli import (
     demo,
     graph,
     launch,
+    patrol,
     run,
     service,
     sim,
@@ -47,6 +48,7 @@ app.add_typer(daemon.app, name="daemon")
 app.command("demo")(demo.demo)
 app.command("sim")(sim.sim)
 app.command("launch")(launch.launch)
+app.command("patrol")(patrol.patrol)
 app.command(
     "run",
     context_settings={"allow_extra_args": True, "ignore_unknown_options": True},
