@@ -2,8 +2,12 @@
 
 from __future__ import annotations
 
+import contextlib
 import math
+import signal
+import threading
 import time
+from collections.abc import Iterator
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -27,6 +31,7 @@ __all__ = [
     "connect_following_clock",
     "network_options",
     "run_context",
+    "stop_on_signals",
 ]
 
 #: ``--clock`` of commands that join a running system (``roverlab run``, ``patrol``).
@@ -97,6 +102,26 @@ def network_options(ctx: typer.Context) -> NetworkOptions:
     """The root command's connection options (``roverlab --connect ... CMD``)."""
     obj = ctx.find_root().obj
     return obj if isinstance(obj, NetworkOptions) else NetworkOptions()
+
+
+@contextlib.contextmanager
+def stop_on_signals(stop: threading.Event) -> Iterator[threading.Event]:
+    """Inside the block SIGINT, SIGTERM and SIGHUP set ``stop`` (the command then finishes
+    its output files and returns) instead of killing the process; the old handlers come
+    back at the end. A second SIGINT interrupts (KeyboardInterrupt)."""
+
+    def on_signal(signum: int, _frame: Any) -> None:
+        if signum == signal.SIGINT and stop.is_set():
+            raise KeyboardInterrupt
+        stop.set()
+
+    sigs = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+    old = {s: signal.signal(s, on_signal) for s in sigs}
+    try:
+        yield stop
+    finally:
+        for s, handler in old.items():
+            signal.signal(s, handler)
 
 
 def run_context(context: Context, duration_s: float | None) -> float:

@@ -12,6 +12,7 @@ from roverlab.cli import (
     amcl_run,
     daemon,
     demo,
+    explore,
     graph,
     launch,
     patrol,
@@ -49,6 +50,7 @@ app.command("demo")(demo.demo)
 app.command("sim")(sim.sim)
 app.command("launch")(launch.launch)
 app.command("patrol")(patrol.patrol)
+app.command("explore")(explore.explore)
 app.command(
     "run",
     context_settings={"allow_extra_args": True, "ignore_unknown_options": True},
