@@ -18,7 +18,7 @@ from tests.helpers.procs import Proc
 RL = [sys.executable, "-m", "roverlab.cli"]
 
 
-def _wait_stderr(p: Proc, text: str, timeout: float = 30.0) -> None:
+def _wait_stderr(p: Proc, text: str, timeout: float = 90.0) -> None:
     deadline = time.monotonic() + timeout
     while text not in p.stderr():
         if p.popen.poll() is not None or time.monotonic() > deadline:
