@@ -37,6 +37,7 @@ from roverlab.msgs import (
     PoseWithCovarianceStamped,
     image_to_array,
     occupancy_grid_to_array,
+    pointcloud2_to_rgb,
     pointcloud2_to_xyz,
     pose_from_xytheta,
     scan_to_points,
@@ -75,6 +76,7 @@ from roverlab.viz.protocol import (
     encode_poses,
     image_to_rgb8,
     robot_outlines,
+    robot_shapes,
 )
 
 __all__ = [
@@ -227,6 +229,7 @@ class VizBridge:
         self._received: dict[str, int] = {}
         self._rate_samples: dict[str, deque[tuple[float, int]]] = {}
         self.outlines: Versioned | None = None
+        self.shapes: list[dict[str, Any]] = []
         self._description_sub: Any = None
         self._description_topic = ""
         self.config = config if config is not None else default_config(fixed_frame)
@@ -356,6 +359,7 @@ class VizBridge:
             self._description_sub = None
         self._description_topic = topic
         self.outlines = None
+        self.shapes = []
         if topic:
             self._description_sub = self.node.create_subscription(
                 "std_msgs/msg/String", topic, self._on_description, _LATCHED
@@ -438,7 +442,7 @@ class VizBridge:
             return
         assert tf is not None
         pts = scan_to_points(msg)
-        world = tf.apply(np.column_stack((pts, np.zeros(len(pts)))))[:, :2]
+        world = tf.apply(np.column_stack((pts, np.zeros(len(pts)))))  # at the laser's height
         values = None
         if cfg.option("color_transformer") == "Intensity" and len(msg.intensities) > 0:
             rng = np.asarray(msg.ranges, dtype=np.float64)
@@ -461,6 +465,20 @@ class VizBridge:
         if not self._tf_status(state, tf, why):
             return
         assert tf is not None
+        transformer = str(cfg.option("color_transformer"))
+        names = {f.name for f in msg.fields}
+        if transformer == "RGB8" and ("rgb" in names or "rgba" in names):
+            xyz_all = pointcloud2_to_xyz(msg)
+            keep = np.isfinite(xyz_all).all(axis=1)
+            step = max(1, math.ceil(int(keep.sum()) / max(1, int(cfg.option("max_points")))))
+            xyz = xyz_all[keep][::step]
+            colours = pointcloud2_to_rgb(msg)[keep][::step]
+            world = tf.apply(xyz.astype(np.float64))
+            alpha = round(max(0.0, min(1.0, float(cfg.option("alpha")))) * 255)
+            state.info = {"points": len(world)}
+            frame = encode_points(world, None, [[255, 255, 255, alpha]], rgb=colours)
+            state.frame = Versioned(self._next(), frame)
+            return
         xyz = pointcloud2_to_xyz(msg, skip_nans=True)
         xyz = decimate(xyz, int(cfg.option("max_points")))
         world = tf.apply(xyz.astype(np.float64))
@@ -472,7 +490,7 @@ class VizBridge:
             values=world[:, 2],
         )
         state.info = {"points": len(world)}
-        state.frame = Versioned(self._next(), encode_points(world[:, :2], idx, palette))
+        state.frame = Versioned(self._next(), encode_points(world, idx, palette))
 
     def _posed(self, state: DisplayState, header: Any, poses: Sequence[Any]) -> np.ndarray | None:
         tf, why = self._lookup_why(str(header.frame_id), _stamp_time(header))
@@ -581,6 +599,7 @@ class VizBridge:
 
     def _on_description(self, msg: Any) -> None:
         model = parse_urdf(str(msg.data), source=self._description_topic)
+        self.shapes = [shape.to_dict() for shape in robot_shapes(model)]
         self.outlines = Versioned(self._next(), robot_outlines(model))
 
     # ---------------------------------------------------------------- queries
@@ -697,10 +716,12 @@ class VizBridge:
         """Small per-tick state: frames, robot outline, per-display info and status."""
         fixed = self.fixed_frame
         frames: dict[str, list[float]] = {}
+        frames3: dict[str, list[float]] = {}
         for name in self.tf_buffer.frames():
             tf = self._lookup(name)
             if tf is not None:
                 frames[name] = _xyyaw(tf)
+                frames3[name] = [round(float(v), 5) for v in (*tf.translation, *tf.rotation)]
         robot: list[dict[str, Any]] = []
         outlines: list[VisualOutline] = self.outlines.payload if self.outlines else []
         for outline in outlines:
@@ -716,6 +737,8 @@ class VizBridge:
             "fixed_frame": fixed,
             "frames": frames,
             "robot": robot,
+            "frames3": frames3,
+            "robot3d": self.shapes,
             "displays": [d.info for d in self.displays],
             "status": self.status(frames, outlines),
             "image_topics": self.image_topics(),
