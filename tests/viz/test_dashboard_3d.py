@@ -29,7 +29,7 @@ from roverlab.core import Context, Time
 from roverlab.description.node import JointStatePublisher, RobotStatePublisher
 from roverlab.geometry import Transform3, quat_from_rpy
 from roverlab.msgs import yaw_from_quaternion
-from roverlab.sim.app import Simulation
+from roverlab.sim.app import Simulation, SpawnPose
 from roverlab.tf import StaticTransformBroadcaster
 from roverlab.tf.convert import transform_to_msg
 from roverlab.viz import DashboardServer
@@ -81,7 +81,13 @@ def _screen(page: Any, x: float, y: float, z: float) -> tuple[float, float]:
 @pytest.fixture(scope="module")
 def mycar() -> Iterator[tuple[Context, DashboardServer, list[Any]]]:
     ctx = Context()
-    Simulation(context=ctx, world=MYCAR / "worlds" / "box_house.world", robot="mycar")
+    # facing box_1 (2.0, 1.5) so the kinect sees a coloured box in front of the white walls
+    Simulation(
+        context=ctx,
+        world=MYCAR / "worlds" / "box_house.world",
+        robot="mycar",
+        spawn=SpawnPose(0.0, 0.0, math.atan2(1.5, 2.0)),
+    )
     # sensor.launch's static_transform_publisher 0 0 0 -1.57 0 -1.57 support support_depth
     node = ctx.create_node("goal_listener")
     optical = Transform3.from_arrays((0.0, 0.0, 0.0), quat_from_rpy(-1.57, 0.0, -1.57))
@@ -120,8 +126,11 @@ def test_mycar_cloud_and_links_in_the_orbit_view(
     _, server, _ = mycar
     page = _open(browser, server, "viz.data.layers.some(l => l && l.points)", 120000)
     assert page.evaluate("() => viz.cam.mode") == "Orbit"  # from test.rviz's Views/Current
-    # closer than test.rviz's 6.2 m so the small car fills the shot
-    page.evaluate("() => { viz.cam.distance = 2.2; viz.cam.focal.set(0.6, 0, 0.1); }")
+    # closer than test.rviz's 6.2 m, from behind the car, towards the box it faces
+    page.evaluate(
+        "() => { viz.cam.distance = 3.2; viz.cam.focal.set(0.9, 0.7, 0.2);"
+        " viz.cam.yaw = Math.atan2(1.5, 2.0) + Math.PI; viz.cam.pitch = 0.45; }"
+    )
     page.wait_for_timeout(800)
     img = _shot(page, tmp_path / "mycar_orbit.png")
     cloud = page.evaluate(
@@ -129,12 +138,13 @@ def test_mycar_cloud_and_links_in_the_orbit_view(
         " let zmax = -1e9, zmin = 1e9, grey = 0; for (let i = 0; i < s.n; i++) {"
         " const z = s.xyz[3 * i + 2]; zmax = Math.max(zmax, z); zmin = Math.min(zmin, z);"
         " const c = s.rgba.subarray(4 * i, 4 * i + 3);"
-        " if (c[0] === c[1] && c[1] === c[2]) grey++; }"
+        " if (Math.max(...c) - Math.min(...c) < 60) grey++; }"
         " return {n: s.n, stride: s.stride, perPoint: s.perPoint, zmin, zmax, grey}; }"
     )
     assert cloud["n"] > 1000 and cloud["stride"] == 3 and cloud["perPoint"]
     assert cloud["zmax"] - cloud["zmin"] > 0.3  # height kept: a wall, not a floor line
-    assert cloud["grey"] < cloud["n"]  # RGB8 colours from the camera, not one flat colour
+    # RGB8 colours from the camera: the box's saturated colour, not one flat colour
+    assert cloud["n"] - cloud["grey"] > 200
     # the car's links: mycar's base_link is a brown (0.5, 0.3, 0, 0.5) cylinder at its TF
     base = page.evaluate("() => viz.data.state.frames3.base_link")
     bx, by = _screen(page, base[0], base[1], base[2])
