@@ -16,8 +16,9 @@ labels.id = "tf-labels";
 labels.style.cssText = "position:absolute;inset:0;pointer-events:none;overflow:hidden;display:none";
 host.appendChild(labels);
 
-const renderer = new THREE.WebGLRenderer({ canvas, antialias: false, preserveDrawingBuffer: true });
+const renderer = new THREE.WebGLRenderer({ canvas, antialias: false, powerPreference: "high-performance" });
 renderer.setClearColor(0x303030);
+renderer.outputColorSpace = THREE.LinearSRGBColorSpace;  // colours pass through as given, as rviz's
 const scene = new THREE.Scene();
 scene.add(new THREE.HemisphereLight(0xffffff, 0x444444, 2.2));
 const sun = new THREE.DirectionalLight(0xffffff, 1.5);
@@ -113,7 +114,11 @@ function slotObject(slot, key, make) {
 function dispose(obj) {
   obj.traverse((c) => {
     if (c.geometry) c.geometry.dispose();
-    if (c.material) { if (c.material.map) c.material.map.dispose(); c.material.dispose(); }
+    if (c.material) {
+      if (c.material.map) c.material.map.dispose();
+      if (c.material.uniforms) for (const u of Object.values(c.material.uniforms)) if (u.value && u.value.isTexture) u.value.dispose();
+      c.material.dispose();
+    }
   });
 }
 function setPose(obj, p) {
@@ -139,26 +144,55 @@ function updateGrid(slot, d) {
   if (p) setPose(e.obj, p);
 }
 
+// The map as rviz draws it: the int8 cells as a one-byte texture and the colour scheme as a
+// 256-entry palette texture, looked up per pixel (a quarter of an RGBA texture's memory
+// traffic, and a scheme change or a patch re-uploads only bytes)
+const MAP_VERTEX = `varying vec2 vUv;
+void main() { vUv = uv; gl_Position = projectionMatrix * modelViewMatrix * vec4(position, 1.0); }`;
+const MAP_FRAGMENT = `uniform sampler2D cells; uniform sampler2D palette; uniform float alpha; varying vec2 vUv;
+void main() {
+  float v = texture2D(cells, vUv).r;
+  vec4 c = texture2D(palette, vec2((v * 255.0 + 0.5) / 256.0, 0.5));
+  if (c.a * alpha <= 0.0) discard;
+  gl_FragColor = vec4(c.rgb, c.a * alpha);
+}`;
+function paletteTexture(scheme) {
+  const pal = viz.PALETTES[scheme] || viz.PALETTES.map;
+  const tex = new THREE.DataTexture(new Uint8Array(pal.buffer.slice(0)), 256, 1, THREE.RGBAFormat);
+  tex.magFilter = tex.minFilter = THREE.NearestFilter; tex.needsUpdate = true;
+  return tex;
+}
 function updateMap(slot, d, L, info) {
   const m = L.map;
   if (!m) return;
   const e = slotObject(slot, `map ${m.w} ${m.h} ${m.res} ${m.ox} ${m.oy} ${m.oyaw}`, () => {
-    const tex = new THREE.CanvasTexture(m.canvas);
-    tex.magFilter = THREE.NearestFilter; tex.minFilter = THREE.LinearFilter; tex.generateMipmaps = false;
-    tex.colorSpace = THREE.SRGBColorSpace;
-    const mat = new THREE.MeshBasicMaterial({ map: tex, transparent: true, depthWrite: false, side: THREE.DoubleSide });
+    const bytes = new Uint8Array(m.cells.buffer, m.cells.byteOffset, m.w * m.h);
+    const cells = new THREE.DataTexture(bytes, m.w, m.h, THREE.RedFormat, THREE.UnsignedByteType);
+    cells.magFilter = cells.minFilter = THREE.NearestFilter; cells.generateMipmaps = false;
+    cells.unpackAlignment = 1; cells.needsUpdate = true;
+    const mat = new THREE.ShaderMaterial({
+      uniforms: { cells: { value: cells }, palette: { value: paletteTexture(d.options.color_scheme) }, alpha: { value: 1 } },
+      vertexShader: MAP_VERTEX, fragmentShader: MAP_FRAGMENT, transparent: true, depthWrite: false, side: THREE.DoubleSide,
+    });
     const plane = new THREE.Mesh(new THREE.PlaneGeometry(m.w * m.res, m.h * m.res), mat);
     plane.position.set(m.w * m.res / 2, m.h * m.res / 2, 0);
     const origin = new THREE.Group(); origin.add(plane);
     origin.position.set(m.ox, m.oy, 0); origin.rotation.z = m.oyaw;
     const g = new THREE.Group(); g.add(origin);
-    g.userData = { tex, mat, version: m.version };
+    g.userData = { cells, mat, version: m.version, scheme: d.options.color_scheme };
     return g;
   });
   const u = e.obj.userData;
-  if (u.version !== m.version || u.scheme !== m.scheme) { u.tex.needsUpdate = true; u.version = m.version; u.scheme = m.scheme; }
-  u.mat.opacity = Math.max(0, Math.min(1, d.options.alpha));
-  e.obj.renderOrder = d.options.draw_behind ? -2 : -1;
+  if (u.version !== m.version) { u.cells.needsUpdate = true; u.version = m.version; }
+  if (u.scheme !== d.options.color_scheme) {
+    u.mat.uniforms.palette.value.dispose();
+    u.mat.uniforms.palette.value = paletteTexture(d.options.color_scheme);
+    u.scheme = d.options.color_scheme;
+  }
+  const alpha = Math.max(0, Math.min(1, d.options.alpha));
+  u.mat.uniforms.alpha.value = alpha;
+  u.mat.transparent = alpha < 1 || d.options.color_scheme === "costmap";
+  e.obj.children[0].children[0].renderOrder = d.options.draw_behind ? -2 : -1;
   const p = frame3(info && info.frame ? info.frame : "map");
   e.obj.visible = !!p;
   if (p) setPose(e.obj, p);
@@ -169,7 +203,7 @@ function updatePoints(slot, d, L) {
   if (!L.points) return;
   const e = slotObject(slot, "points", () => {
     const geo = new THREE.BufferGeometry();
-    const mat = new THREE.PointsMaterial({ size: 3, sizeAttenuation: false, vertexColors: true, transparent: true });
+    const mat = new THREE.PointsMaterial({ size: 3, sizeAttenuation: false, vertexColors: true });
     const pts = new THREE.Points(geo, mat); pts.frustumCulled = false;
     return pts;
   });
@@ -177,25 +211,32 @@ function updatePoints(slot, d, L) {
   if (decay > 0) L.points = L.points.filter((p, i) => i === L.points.length - 1 || now - p.t < decay);
   const key = L.points.length + ":" + (L.version || 0);
   e.obj.material.size = d.options.size_px || 3;
+  e.obj.material.transparent = d.options.alpha < 1;
   if (e.drawn === key) return;
   e.drawn = key;
   let total = 0;
   for (const s of L.points) total += s.n;
   const step = Math.max(1, Math.ceil(total / MAX_DRAWN_POINTS));  // decimated for drawing
-  const n = Math.ceil(total / step), pos = new Float32Array(n * 3), rgb = new Uint8Array(n * 4);
+  const n = Math.ceil(total / step), geo = e.obj.geometry;
+  if (!e.cap || e.cap < n) {  // buffers grow, then are rewritten in place (no re-allocation per scan)
+    e.cap = Math.max(n, 1024);
+    e.pos = new THREE.BufferAttribute(new Float32Array(e.cap * 3), 3).setUsage(THREE.DynamicDrawUsage);
+    e.rgb = new THREE.BufferAttribute(new Uint8Array(e.cap * 4), 4, true).setUsage(THREE.DynamicDrawUsage);
+    geo.setAttribute("position", e.pos); geo.setAttribute("color", e.rgb);
+  }
+  const pos = e.pos.array, rgb = e.rgb.array;
   let k = 0, idx = 0;
   for (const s of L.points) {
     for (let i = 0; i < s.n; i++, idx++) {
       if (idx % step) continue;
       const a = i * s.stride;
       pos[3 * k] = s.xyz[a]; pos[3 * k + 1] = s.xyz[a + 1]; pos[3 * k + 2] = s.stride === 3 ? s.xyz[a + 2] : 0;
-      rgb.set(s.rgba.subarray(4 * i, 4 * i + 4), 4 * k);
+      rgb[4 * k] = s.rgba[4 * i]; rgb[4 * k + 1] = s.rgba[4 * i + 1]; rgb[4 * k + 2] = s.rgba[4 * i + 2]; rgb[4 * k + 3] = s.rgba[4 * i + 3];
       k++;
     }
   }
-  const geo = e.obj.geometry;
-  geo.setAttribute("position", new THREE.BufferAttribute(pos.subarray(0, 3 * k), 3));
-  geo.setAttribute("color", new THREE.BufferAttribute(rgb.subarray(0, 4 * k), 4, true));
+  e.pos.clearUpdateRanges(); e.pos.addUpdateRange(0, 3 * k); e.pos.needsUpdate = true;
+  e.rgb.clearUpdateRanges(); e.rgb.addUpdateRange(0, 4 * k); e.rgb.needsUpdate = true;
   geo.setDrawRange(0, k);
   e.obj.userData.count = k;
 }
@@ -460,7 +501,9 @@ function frame() {
   if (cam.mode === "2D") return;
   const w = host.clientWidth, h = host.clientHeight;
   if (canvas.width !== w || canvas.height !== h) renderer.setSize(w, h, false);
+  const t0 = performance.now();
   updateScene();
+  const t1 = performance.now();
   camera = placeCamera(w, h);
   if (drag && drag.tool !== "camera") {
     const c = drag.tool === "goal" ? 0x50ff50 : drag.tool === "point" ? 0xffdc50 : 0x50a0ff;
@@ -468,7 +511,10 @@ function frame() {
     toolArrow.children.forEach((m) => m.material.color.setHex(c));
   } else toolArrow.visible = false;
   renderer.render(scene, camera);
+  const t2 = performance.now();
   placeLabels(camera, w, h);
+  cam.msUpdate = 0.9 * (cam.msUpdate || 0) + 0.1 * (t1 - t0);
+  cam.msRender = 0.9 * (cam.msRender || 0) + 0.1 * (t2 - t1);
   cam.frames += 1; fpsN += 1;
   const now = performance.now();
   if (now - fpsT0 >= 1000) { cam.fps = fpsN * 1000 / (now - fpsT0); fpsN = 0; fpsT0 = now; }
