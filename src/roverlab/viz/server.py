@@ -45,6 +45,7 @@ from fastapi.responses import FileResponse, PlainTextResponse, Response
 from fastapi.staticfiles import StaticFiles
 
 from roverlab.core import Context
+from roverlab.description.packages import resolve_uri
 from roverlab.errors import RoverlabError
 from roverlab.viz.bridge import DisplayState, VizBridge
 from roverlab.viz.config import DashboardConfig, config_from_dict, save_config
@@ -168,6 +169,23 @@ class DashboardServer:
                 media_type="application/json",
                 headers={"Content-Disposition": f'attachment; filename="{DEFAULT_CONFIG_NAME}"'},
             )
+
+        @app.get("/mesh/{index}")
+        def mesh(index: int, request: Request) -> Response:
+            """The mesh file of the robot model's ``index``-th visual (only those files)."""
+            if not self._authorised(request.query_params.get("token")):
+                return PlainTextResponse("forbidden: wrong or missing token", status_code=403)
+            shapes = self.bridge.shapes
+            if not 0 <= index < len(shapes) or shapes[index]["geometry"]["type"] != "mesh":
+                return PlainTextResponse(f"no mesh visual {index}", status_code=404)
+            uri = str(shapes[index]["geometry"]["filename"])
+            try:
+                path = resolve_uri(uri)
+            except RoverlabError as err:
+                return PlainTextResponse(f"{uri}: {err}", status_code=404)
+            if not path.is_file():
+                return PlainTextResponse(f"{uri}: no such file {path}", status_code=404)
+            return FileResponse(path)
 
         app.mount("/static", StaticFiles(directory=STATIC_DIR), name="static")
 

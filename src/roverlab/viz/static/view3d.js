@@ -2,6 +2,8 @@
 // ThirdPersonFollower camera controllers over the data app.js keeps in window.viz.data.
 // z is up, as in ROS; every pose comes in the fixed frame.
 import * as THREE from "three";
+import { STLLoader } from "./vendor/three/addons/loaders/STLLoader.js";
+import { ColladaLoader } from "./vendor/three/addons/loaders/ColladaLoader.js";
 
 const viz = window.viz;
 const data = viz.data;
@@ -16,6 +18,7 @@ labels.id = "tf-labels";
 labels.style.cssText = "position:absolute;inset:0;pointer-events:none;overflow:hidden;display:none";
 host.appendChild(labels);
 
+THREE.ColorManagement.enabled = false;  // colours pass through as given (rviz's 0..1 RGB)
 const renderer = new THREE.WebGLRenderer({ canvas, antialias: false, powerPreference: "high-performance" });
 renderer.setClearColor(0x303030);
 renderer.outputColorSpace = THREE.LinearSRGBColorSpace;  // colours pass through as given, as rviz's
@@ -241,8 +244,36 @@ function updatePoints(slot, d, L) {
   e.obj.userData.count = k;
 }
 
-function makeShape(geometry, rgba, alpha) {
+// URDF mesh visuals: STL (in the URDF material's colour) and COLLADA (its own materials),
+// fetched from the dashboard's /mesh/<visual index>, the files of the loaded model only
+const token = new URLSearchParams(location.search).get("token");
+const meshQuery = token ? "?token=" + encodeURIComponent(token) : "";
+viz.meshes = { loaded: 0, failed: 0 };
+function loadMesh(index, geometry, rgba, alpha) {
+  const holder = new THREE.Group();
+  holder.scale.set(...geometry.scale);
+  const url = `mesh/${index}${meshQuery}`, name = geometry.filename.toLowerCase();
+  const a = rgba[3] * alpha;
+  const done = (obj) => { holder.add(obj); viz.meshes.loaded += 1; };
+  const fail = (err) => { viz.meshes.failed += 1; console.warn("mesh", geometry.filename, err); };
+  if (name.endsWith(".stl")) {
+    new STLLoader().load(url, (geo) => {
+      geo.computeVertexNormals();
+      done(new THREE.Mesh(geo, new THREE.MeshLambertMaterial({ color: new THREE.Color(rgba[0], rgba[1], rgba[2]), transparent: a < 1, opacity: a })));
+    }, undefined, fail);
+  } else if (name.endsWith(".dae")) {
+    new ColladaLoader().load(url, (collada) => {
+      // the loader turns Z_UP files to three's y-up; ROS is z-up: undo it (and turn y-up files)
+      collada.scene.rotation.set(collada.scene.rotation.x !== 0 ? 0 : Math.PI / 2, 0, 0);
+      done(collada.scene);
+    }, undefined, fail);
+  } else fail("unsupported mesh format");
+  return holder;
+}
+
+function makeShape(geometry, rgba, alpha, index) {
   let geo;
+  if (geometry.type === "mesh") return loadMesh(index, geometry, rgba, alpha);
   if (geometry.type === "box") geo = new THREE.BoxGeometry(...geometry.size);
   else if (geometry.type === "cylinder") {
     geo = new THREE.CylinderGeometry(geometry.radius, geometry.radius, geometry.length, 24);
@@ -259,8 +290,8 @@ function updateRobot(slot, d) {
   const key = "robot " + JSON.stringify(s.robot3d) + d.options.alpha;
   const e = slotObject(slot, key, () => {
     const g = new THREE.Group();
-    for (const v of s.robot3d) {
-      const mesh = makeShape(v.geometry, v.rgba, d.options.alpha);
+    for (const [i, v] of s.robot3d.entries()) {
+      const mesh = makeShape(v.geometry, v.rgba, d.options.alpha, i);
       if (!mesh) continue;
       const link = new THREE.Group(); link.userData.link = v.link; link.name = v.link;
       setPose(mesh, v.origin); link.add(mesh); g.add(link);
