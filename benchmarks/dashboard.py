@@ -9,7 +9,9 @@ circle), a 720-beam LaserScan at 10 Hz and a 640 x 480 depth PointCloud2 at 10 H
 curved wall in front of the robot, AxisColor; the display's Max Points decimates it on the
 server, 20,000 by default), opens the page in Debian's chromium (Playwright, headless,
 software rendering), in the 3D view (rviz's Orbit, three.js / WebGL on SwiftShader) and in
-the 2D view, and prints for each:
+the 2D view, and prints for each (the 3D view twice: with its adaptive resolution, which
+lowers the drawing-buffer resolution down to half per axis while the frame rate is below 28,
+and at fixed full resolution):
 
 - frames per second the page renders, counted with ``requestAnimationFrame`` in the browser
   over the window (target >= 30);
@@ -143,7 +145,9 @@ def _cpu_s() -> float:
     return t.user + t.system
 
 
-def _measure(browser: Any, server: DashboardServer, view: str, seconds: float) -> dict[str, float]:
+def _measure(
+    browser: Any, server: DashboardServer, view: str, seconds: float, *, adaptive: bool = True
+) -> dict[str, float]:
     page = browser.new_page(viewport={"width": 1600, "height": 900})
     cdp: Any = page.context.new_cdp_session(page)
     cdp.send("Network.enable")
@@ -164,12 +168,13 @@ def _measure(browser: Any, server: DashboardServer, view: str, seconds: float) -
     first_map_s = time.monotonic() - t0
     if view == "3d":  # rviz's Orbit, the whole 100 m map in view
         page.evaluate(
-            "() => { viz.setViewMode('Orbit'); viz.cam.distance = 90; viz.cam.pitch = 0.9;"
-            " viz.cam.focal.set(0, 0, 0); }"
+            "(adaptive) => { viz.setViewMode('Orbit'); viz.cam.distance = 90; viz.cam.pitch = 0.9;"
+            " viz.cam.focal.set(0, 0, 0); viz.cam.adaptive = adaptive; }",
+            adaptive,
         )
     else:
         page.evaluate("() => { viz.setViewMode('2D'); viz.view.scale = 12; }")
-    page.wait_for_timeout(1500)
+    page.wait_for_timeout(4000)  # the adaptive resolution settles
     received["bytes"] = 0
     cpu0, wall0 = _cpu_s(), time.monotonic()
     frames = page.evaluate(
@@ -186,7 +191,7 @@ def _measure(browser: Any, server: DashboardServer, view: str, seconds: float) -
     wall = time.monotonic() - wall0
     cpu = _cpu_s() - cpu0
     drawn = page.evaluate("() => viz.data.layers[3].points.at(-1).n")  # the Depth display
-    ms = page.evaluate("() => [viz.cam.msUpdate || 0, viz.cam.msRender || 0]")
+    ms = page.evaluate("() => [viz.cam.msUpdate || 0, viz.cam.msRender || 0, viz.cam.resolution]")
     page.close()
     return {
         "fps": frames / wall,
@@ -197,6 +202,7 @@ def _measure(browser: Any, server: DashboardServer, view: str, seconds: float) -
         "cloud_points": float(drawn),
         "ms_update": float(ms[0]),
         "ms_render": float(ms[1]),
+        "resolution": float(ms[2]),
     }
 
 
@@ -228,10 +234,17 @@ def main() -> None:
             f"  map {args.map_cells} x {args.map_cells} cells, 720-beam scan at 10 Hz, "
             "640 x 480 depth cloud at 10 Hz, robot moving (TF at 10 Hz)"
         )
-        views = ("3d", "2d") if args.view == "both" else (args.view,)
-        for view in views:
-            r = _measure(browser, server, view, args.seconds)
-            print(f"  {view.upper()} view (window {r['wall']:.1f} s):")
+        runs = [("3d", True), ("3d", False), ("2d", True)]
+        for view, adaptive in runs:
+            if args.view not in ("both", view):
+                continue
+            r = _measure(browser, server, view, args.seconds, adaptive=adaptive)
+            what = (
+                ""
+                if view == "2d"
+                else (", adaptive resolution" if adaptive else ", full resolution")
+            )
+            print(f"  {view.upper()} view{what} (window {r['wall']:.1f} s):")
             print(f"    first map on the page:    {r['first_map']:6.2f} s after page load")
             print(f"    page frame rate:          {r['fps']:6.1f} fps (target >= 30)")
             print(f"    cloud points drawn:       {r['cloud_points']:6.0f} of 307200 per frame")
@@ -240,6 +253,7 @@ def main() -> None:
                     f"    per frame:                {r['ms_update']:6.1f} ms scene update, "
                     f"{r['ms_render']:.1f} ms WebGL render"
                 )
+                print(f"    adaptive resolution:      {r['resolution']:6.3f} of full (per axis)")
             print(f"    server process CPU:       {r['cpu']:6.1f} % of one core")
             print(f"    websocket traffic:        {r['kib']:6.1f} KiB/s")
     finally:

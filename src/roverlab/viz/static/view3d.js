@@ -20,6 +20,7 @@ host.appendChild(labels);
 
 THREE.ColorManagement.enabled = false;  // colours pass through as given (rviz's 0..1 RGB)
 const renderer = new THREE.WebGLRenderer({ canvas, antialias: false, powerPreference: "high-performance" });
+renderer.setPixelRatio(window.devicePixelRatio || 1);
 renderer.setClearColor(0x303030);
 renderer.outputColorSpace = THREE.LinearSRGBColorSpace;  // colours pass through as given, as rviz's
 const scene = new THREE.Scene();
@@ -36,7 +37,8 @@ ortho.up.set(0, 1, 0);
 // rviz's view controllers: Orbit (focal point, distance, yaw, pitch), TopDownOrtho
 // (centre x, y, scale px/m, angle), ThirdPersonFollower (an orbit about a frame, turning with it)
 const cam = { mode: "2D", focal: new THREE.Vector3(0, 0, 0), distance: 10, yaw: 0.785, pitch: 0.785,
-              x: 0, y: 0, scale: 50, angle: 0, target: "", frames: 0, fps: 0 };
+              x: 0, y: 0, scale: 50, angle: 0, target: "", frames: 0, fps: 0, resolution: 1,
+              adaptive: true };
 viz.cam = cam;
 
 function setMode(mode) {
@@ -531,7 +533,8 @@ function frame() {
   requestAnimationFrame(frame);
   if (cam.mode === "2D") return;
   const w = host.clientWidth, h = host.clientHeight;
-  if (canvas.width !== w || canvas.height !== h) renderer.setSize(w, h, false);
+  const pr = renderer.getPixelRatio();
+  if (canvas.width !== Math.floor(w * pr) || canvas.height !== Math.floor(h * pr)) renderer.setSize(w, h, false);
   const t0 = performance.now();
   updateScene();
   const t1 = performance.now();
@@ -548,7 +551,16 @@ function frame() {
   cam.msRender = 0.9 * (cam.msRender || 0) + 0.1 * (t2 - t1);
   cam.frames += 1; fpsN += 1;
   const now = performance.now();
-  if (now - fpsT0 >= 1000) { cam.fps = fpsN * 1000 / (now - fpsT0); fpsN = 0; fpsT0 = now; }
+  if (now - fpsT0 >= 1000) {
+    cam.fps = fpsN * 1000 / (now - fpsT0); fpsN = 0; fpsT0 = now;
+    // adaptive resolution: a slow (software) renderer draws fewer pixels, down to half per
+    // axis, to keep the view interactive; back to full resolution when there is headroom
+    const r = cam.resolution;
+    if (!cam.adaptive) cam.resolution = 1;
+    else if (cam.fps < 28 && r > 0.5) cam.resolution = Math.max(0.5, r - 0.125);
+    else if (cam.fps > 50 && r < 1) cam.resolution = Math.min(1, r + 0.125);
+    if (cam.resolution !== r) renderer.setPixelRatio(cam.resolution * (window.devicePixelRatio || 1));
+  }
 }
 const sel = document.getElementById("view-mode");
 if (sel) sel.onchange = () => setMode(sel.value);
