@@ -6,8 +6,8 @@ the :class:`~roverlab.viz.config.DashboardConfig` and one :class:`DisplayState` 
 executor thread and only store the newest data with a version number; the web server's
 threads read snapshots and compare versions, so each client gets only what changed. What a
 message becomes is each display type's own handler (:mod:`roverlab.viz.handlers`, one per
-display, as rviz has one plugin per display). Configuration changes from the page are applied on the executor thread
-(:meth:`VizBridge.set_config`).
+display, as rviz has one plugin per display). Configuration changes from the page are
+applied on the executor thread (:meth:`VizBridge.set_config`).
 """
 
 from __future__ import annotations
