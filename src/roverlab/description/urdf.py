@@ -362,6 +362,7 @@ def robot_description(
     args: Mapping[str, str] | None = None,
     *,
     package_path: Iterable[str | os.PathLike[str]] = (),
+    xacro_ns: bool = False,
 ) -> str:
     """The URDF XML a launch file would put in the ``robot_description`` parameter.
 
@@ -376,11 +377,11 @@ def robot_description(
     if _is_xml(path_or_xml):
         text = str(path_or_xml)
         if "xmlns:xacro" in text:
-            return xacro_string(text, args=args, package_path=packages)
+            return xacro_string(text, args=args, package_path=packages, xacro_ns=xacro_ns)
         return text
     path = Path(path_or_xml)
     if path.suffix == ".xacro":
-        return xacro_file(path, args=args, package_path=packages)
+        return xacro_file(path, args=args, package_path=packages, xacro_ns=xacro_ns)
     try:
         text = path.read_text(encoding="utf-8")
     except OSError as err:
@@ -388,7 +389,7 @@ def robot_description(
     except UnicodeDecodeError as err:
         raise URDFError(f"{path}: not a UTF-8 text file") from err
     if "xmlns:xacro" in text:
-        return xacro_file(path, args=args, package_path=packages)
+        return xacro_file(path, args=args, package_path=packages, xacro_ns=xacro_ns)
     return text
 
 
@@ -397,6 +398,7 @@ def load_robot(
     *,
     args: Mapping[str, str] | None = None,
     package_path: Iterable[str | os.PathLike[str]] = (),
+    xacro_ns: bool = False,
 ) -> RobotModel:
     """Load a robot from a ``.urdf`` / ``.xacro`` / ``.urdf.xacro`` file or an XML string.
 
@@ -411,5 +413,5 @@ def load_robot(
         URDFError: the robot is not valid.
     """
     source = "<string>" if _is_xml(path_or_xml) else str(path_or_xml)
-    xml_text = robot_description(path_or_xml, args, package_path=package_path)
+    xml_text = robot_description(path_or_xml, args, package_path=package_path, xacro_ns=xacro_ns)
     return parse_urdf(xml_text, source=source)
