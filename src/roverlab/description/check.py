@@ -139,4 +139,5 @@ def format_check(model: RobotModel) -> str:
             "warning: <gazebo reference> names no link or joint: "
             + ", ".join(f"'{r}'" for r in unknown)
         )
+    lines.extend(f"warning: {w}" for w in model.warnings)
     return "\n".join(lines)
