@@ -9,7 +9,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
 import trimesh
 
 HERE = Path(__file__).resolve().parent
@@ -21,6 +20,17 @@ def _write(mesh: trimesh.Trimesh, path: Path, **kwargs: object) -> None:
     path.write_bytes(data if isinstance(data, bytes) else data.encode())
 
 
+def _dae(mesh: trimesh.Trimesh, path: Path, meter: float, up: str) -> None:
+    """Collada with the given ``<unit meter>`` and ``<up_axis>`` (trimesh writes Y_UP)."""
+    dae = mesh.export(file_type="dae").decode()
+    head, _, rest = dae.partition("</asset>")
+    head = "\n".join(ln for ln in head.split("\n") if "<unit" not in ln and "<up_axis" not in ln)
+    head = "\n".join(ln for ln in head.split("\n") if ln.strip())
+    asset = f'\n    <unit meter="{meter}" name="unit"/>\n    <up_axis>{up}</up_axis>\n  </asset>'
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(head + asset + rest)
+
+
 def main() -> None:
     robot = HERE / "book_robot_description" / "meshes"
     # rplidar in millimetres (the URDF scales it by 0.001): r 35 mm, 40 mm high
@@ -28,7 +38,7 @@ def main() -> None:
     # kinect body: 0.07 x 0.28 x 0.07 m box, red
     kinect = trimesh.creation.box(extents=(0.07, 0.28, 0.07))
     kinect.visual.face_colors = [200, 30, 30, 255]
-    _write(kinect, robot / "kinect.dae")
+    _dae(kinect, robot / "kinect.dae", 1.0, "Z_UP")
     # a base plate used only as a mesh collision (footprint test): 0.5 x 0.3 m, 0.1 m high
     _write(trimesh.creation.box(extents=(0.5, 0.3, 0.1)), robot / "base_plate.stl")
 
@@ -42,17 +52,7 @@ def main() -> None:
     dumpster = trimesh.creation.box(extents=(150.0, 120.0, 100.0))
     dumpster.apply_translation((0.0, 60.0, 0.0))
     dumpster.visual.face_colors = [20, 110, 40, 255]
-    dae = dumpster.export(file_type="dae").decode()
-    head, _, rest = dae.partition("</asset>")
-    head = "\n".join(ln for ln in head.split("\n") if "<unit" not in ln and "<up_axis" not in ln)
-    dae = (
-        head
-        + '\n    <unit meter="0.01" name="centimeter"/>\n    <up_axis>Y_UP</up_axis>\n  </asset>'
-        + rest
-    )
-    path = models / "dumpster" / "meshes" / "dumpster.dae"
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(dae)
+    _dae(dumpster, models / "dumpster" / "meshes" / "dumpster.dae", 0.01, "Y_UP")
     # construction cone: OBJ, a cone of radius 0.2 m, 0.7 m high, two parts (cone + base)
     cone = trimesh.creation.cone(radius=0.2, height=0.7, sections=12)
     base = trimesh.creation.box(extents=(0.45, 0.45, 0.03))
@@ -60,7 +60,6 @@ def main() -> None:
     _write(
         trimesh.util.concatenate([cone, base]), models / "construction_cone" / "meshes" / "cone.obj"
     )
-    np.random.default_rng(0)  # (no random draws: the shapes are exact)
 
 
 if __name__ == "__main__":

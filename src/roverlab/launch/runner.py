@@ -7,11 +7,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from roverlab.core import Context, Node, QoSProfile
+from roverlab.description.check import robot_warnings
 from roverlab.launch.registry import REGISTRY, LaunchState
 from roverlab.launch.xml import LaunchError, LaunchSpec, load_launch
 from roverlab.msgs import classes as mc
 from roverlab.sim.node import SimulatorNode, SpawnPose
 from roverlab.sim.robot import sim_config_from_model
+from roverlab.world import world_warnings
 
 __all__ = ["Launch", "build_launch"]
 
@@ -25,6 +27,10 @@ class Launch:
     nodes: list[Node] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
     simulator: SimulatorNode | None = None
+    world_warnings: list[str] = field(default_factory=list)
+    """The Gazebo world's warnings, grouped (models and meshes not found, ...)."""
+    robot_warnings: list[str] = field(default_factory=list)
+    """The spawned robot's warnings (urdfdom's, unsupported plugins and sensors)."""
 
 
 def build_launch(
@@ -71,6 +77,7 @@ def build_launch(
         if len(state.spawns) > 1:
             raise LaunchError(f"{state.spawns[1][2]}: one robot per simulation is supported")
         robot, (x, y, yaw), _ = state.spawns[0]
+        launch.robot_warnings = robot_warnings(robot)
         launch.simulator = SimulatorNode(
             context=context,
             scene=state.world.to_scene(),
@@ -90,5 +97,7 @@ def build_launch(
             launch.nodes.append(holder)
     elif state.world is not None:
         state.warnings.append(f"{state.world_source}: a world without a spawned robot")
+    if state.world is not None:
+        launch.world_warnings = world_warnings(state.world)
     launch.warnings = state.warnings
     return launch
