@@ -49,6 +49,7 @@ class NodeSpec:
     params: dict[str, Any] = field(default_factory=dict)
     remaps: dict[str, str] = field(default_factory=dict)
     source: str = ""
+    clear_params: bool = False
 
     @property
     def fq_name(self) -> str:
@@ -302,6 +303,14 @@ class _Reader:
             else:
                 raise LaunchError(f"{_where(scope, child)}: not allowed inside <node>")
         node.params = {k.lstrip("/"): v for k, v in node.params.items()}
+        # clear_params="true": roslaunch empties the node's private namespace on the
+        # parameter server before it sets this launch's parameters. roverlab keeps no
+        # parameters between launches, so a node's private parameters are always this
+        # launch's only: the attribute is checked and holds already.
+        clear = self.attr(elem, "clear_params", scope, "false").lower()
+        if clear not in ("true", "false", "1", "0"):
+            raise LaunchError(f"{_where(scope, elem)}: clear_params must be true or false")
+        node.clear_params = clear in ("true", "1")
         self.spec.nodes.append(node)
 
     def on_include(self, elem: ET.Element, scope: _Scope, passed: set[str]) -> None:
