@@ -350,8 +350,8 @@ def parse_urdf(xml_text: str, *, source: str = "<string>") -> RobotModel:
     _unique("link", (e.get("name", "") for e in link_elems), ctx)
     _unique("joint", (e.get("name", "") for e in joint_elems), ctx)
     warnings: list[str] = []
-    for name_, m in materials.items():
-        if m.rgba is None and m.texture is None:
+    for name_, mat in materials.items():
+        if mat.rgba is None and mat.texture is None:
             warnings.append(
                 ctx.fail(f"<material name='{name_}'> has no <color> or <texture>").args[0]
             )
@@ -368,14 +368,14 @@ def parse_urdf(xml_text: str, *, source: str = "<string>") -> RobotModel:
         urdf=xml_text,
         warnings=tuple(warnings),
     )
-    root = model.links[model.root_link]
-    if root.inertial is not None:  # robot_state_publisher's KDL parser warns so
+    root_link = model.links[model.root_link]
+    if root_link.inertial is not None:  # robot_state_publisher's KDL parser warns so
         object.__setattr__(
             model,
             "warnings",
             (
                 *model.warnings,
-                f"{source}: the root link {root.name} has an inertia specified in the URDF, "
+                f"{source}: the root link {root_link.name} has an inertia specified in the URDF, "
                 "but KDL does not support a root link with an inertia (add a dummy root link "
                 "such as base_footprint)",
             ),

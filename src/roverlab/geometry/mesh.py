@@ -226,7 +226,7 @@ def _process(path: Path, data: bytes) -> tuple[MeshPart, ...]:
     import trimesh
 
     try:
-        loaded = trimesh.load(path, force="scene", process=False)
+        loaded: Any = trimesh.load(path, force="scene", process=False)
     except Exception as err:  # trimesh and pycollada raise many kinds
         raise MeshError(f"{path}: cannot read mesh: {' '.join(str(err).split()) or err}") from err
     frame = _collada_frame(data) if path.suffix.lower() == ".dae" else np.eye(4)
