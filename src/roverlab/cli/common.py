@@ -98,6 +98,21 @@ class Connection:
         self.close()
 
 
+def report_warnings(title: str, lines: list[str], strict: bool) -> None:
+    """Print a loader's warnings loudly on stderr under a count; with ``--strict`` they
+    are errors (exit status 2) rather than warnings."""
+    if not lines:
+        return
+    label = "error" if strict else "warning"
+    noun = "problem" if len(lines) == 1 else "problems"
+    typer.echo(f"{label}: {title}: {len(lines)} {noun}:", err=True)
+    for line in lines:
+        typer.echo(f"  - {line}", err=True)
+    if strict:
+        typer.echo(f"error: --strict: {title} is not loaded as its files say", err=True)
+        raise typer.Exit(2)
+
+
 def network_options(ctx: typer.Context) -> NetworkOptions:
     """The root command's connection options (``roverlab --connect ... CMD``)."""
     obj = ctx.find_root().obj

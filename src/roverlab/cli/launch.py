@@ -9,7 +9,7 @@ from typing import Annotated
 import typer
 
 from roverlab.bag import McapRecorder
-from roverlab.cli.common import choose_expose, network_options, run_context
+from roverlab.cli.common import choose_expose, network_options, report_warnings, run_context
 from roverlab.cli.sim import parse_rate
 from roverlab.core import Context, configure_logging
 from roverlab.core.transport.zenoh import ZenohTransport
@@ -98,6 +98,14 @@ def launch(
             "always its own clock (paced by --rate); external; wall.",
         ),
     ] = "auto",
+    strict: Annotated[
+        bool,
+        typer.Option(
+            "--strict",
+            help="Make every warning (a node roverlab does not have, an unused parameter, "
+            "a world model or mesh not found, an unsupported robot plugin) an error.",
+        ),
+    ] = False,
 ) -> None:
     """Run a .launch file (roslaunch): its nodes, its Gazebo world and spawned robot."""
     path, args = _resolve(target)
@@ -121,8 +129,15 @@ def launch(
             recorder.abort()
         context.shutdown()
         raise
-    for warning in started.warnings:
-        typer.echo(f"warning: {warning}", err=True)
+    try:
+        report_warnings(f"launch {path.name}", started.warnings, strict)
+        report_warnings("Gazebo world", started.world_warnings, strict)
+        report_warnings("spawned robot", started.robot_warnings, strict)
+    except BaseException:
+        if recorder is not None:
+            recorder.abort()
+        context.shutdown()
+        raise
     names = ", ".join(n.get_fully_qualified_name() for n in started.nodes)
     typer.echo(f"started {len(started.nodes)} nodes: {names}", err=True)
     started.supervise()

@@ -148,13 +148,30 @@ class StaticTransformPublisher(Node):
     """tf2_ros static_transform_publisher: ``x y z yaw pitch roll frame child`` or
     ``x y z qx qy qz qw frame child`` (ROS 1 order), latched on ``/tf_static``."""
 
-    def __init__(self, context: Context, *, args: str, source: str, **kwargs: Any) -> None:
+    def __init__(
+        self, context: Context, *, args: str, source: str, pkg: str = "tf2_ros", **kwargs: Any
+    ) -> None:
         super().__init__(
             kwargs.pop("node_name", "static_transform_publisher"), context=context, **kwargs
         )
         parts = shlex.split(args)
-        if len(parts) in (9, 10):  # ROS 1 tf's trailing period in ms
-            parts = parts[:8] if len(parts) == 9 else parts[:9]
+        if pkg == "tf":  # ROS 1 tf: a trailing period in ms (republished; latched here)
+            if len(parts) not in (9, 10):
+                raise LaunchError(
+                    f"{source}: tf/static_transform_publisher needs 'x y z yaw pitch roll "
+                    f"frame child period_in_ms' or 'x y z qx qy qz qw frame child "
+                    f"period_in_ms', got {args!r}"
+                )
+            try:
+                period = float(parts[-1])
+            except ValueError:
+                period = float("nan")
+            if not period > 0:
+                raise LaunchError(
+                    f"{source}: tf/static_transform_publisher: period_in_ms {parts[-1]!r} "
+                    "must be a positive number"
+                )
+            parts = parts[:-1]
         if len(parts) not in (8, 9):
             raise LaunchError(
                 f"{source}: static_transform_publisher needs 'x y z yaw pitch roll frame child' "
@@ -195,7 +212,12 @@ class StaticTransformPublisher(Node):
 
 def _static_tf(state: LaunchState, spec: NodeSpec) -> Node:
     return StaticTransformPublisher(
-        state.context, args=spec.args, source=spec.source, node_name=spec.name, **_kwargs(spec)
+        state.context,
+        args=spec.args,
+        source=spec.source,
+        pkg=spec.pkg,
+        node_name=spec.name,
+        **_kwargs(spec),
     )
 
 
@@ -319,6 +341,18 @@ def _rviz(state: LaunchState, spec: NodeSpec) -> Node | None:
         raise LaunchError(f"{spec.source}: rviz: {err}") from err
 
 
+_NO_JOYSTICK = (
+    "no joystick here: roverlab reads no /dev/input devices; drive with `roverlab teleop` "
+    "(the keyboard, as teleop_twist_keyboard) or publish /cmd_vel"
+)
+for _key in (
+    ("joy", "joy_node"),
+    ("joy", "joy"),
+    ("teleop_twist_joy", "teleop_node"),
+    ("teleop_twist_joy", "teleop_twist_joy"),
+    ("turtlebot_teleop", "turtlebot_teleop_joy"),
+):
+    REGISTRY[_key] = _unavailable(_NO_JOYSTICK)
 REGISTRY[("rqt_image_view", "rqt_image_view")] = _unavailable(
     "open `roverlab dashboard` in another terminal: it has the image panel"
 )
