@@ -9,7 +9,6 @@ from __future__ import annotations
 import math
 import shlex
 from collections.abc import Callable
-from dataclasses import dataclass, field
 from importlib.metadata import entry_points
 from pathlib import Path
 from typing import Any
@@ -19,6 +18,8 @@ from roverlab.description import load_robot
 from roverlab.description.node import JointStatePublisher, RobotStatePublisher
 from roverlab.errors import RoverlabError
 from roverlab.geometry import quat_from_rpy
+from roverlab.launch.devices import DEVICE_NODES
+from roverlab.launch.state import LaunchState, NodeFactory
 from roverlab.launch.xml import LaunchError, NodeSpec
 from roverlab.localization.amcl.node import AmclNode
 from roverlab.mapping.gmapping.node import SlamGMapping
@@ -32,22 +33,6 @@ from roverlab.world import BUNDLED_WORLDS, load_world
 
 __all__ = ["REGISTRY", "LaunchState", "NodeFactory", "register"]
 
-
-@dataclass
-class LaunchState:
-    """What the nodes of one launch share: the context, global parameters, and the
-    simulation being assembled (gzserver gives the world, spawn_model the robot)."""
-
-    context: Context
-    params: dict[str, Any]
-    world: Any = None
-    world_source: str = ""
-    spawns: list[tuple[Any, tuple[float, float, float], str]] = field(default_factory=list)
-    spawn_urdf: str = ""
-    warnings: list[str] = field(default_factory=list)
-
-
-NodeFactory = Callable[[LaunchState, NodeSpec], Node | None]
 
 REGISTRY: dict[tuple[str, str], NodeFactory] = {}
 
@@ -320,3 +305,8 @@ for _t in ("teleop_twist_keyboard.py", "teleop_twist_keyboard"):
     REGISTRY[("teleop_twist_keyboard", _t)] = _unavailable(
         "it needs a terminal: run `roverlab teleop` in one"
     )
+
+for _key, _factory in DEVICE_NODES.items():
+    if _key in REGISTRY:
+        raise LaunchError(f"node {_key[0]}/{_key[1]} is registered twice")
+    REGISTRY[_key] = _factory
