@@ -13,13 +13,16 @@ the file and the node.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Final
 
 from roverlab.core import Node
 from roverlab.drivers.arbotix.node import ArbotixDriver
+from roverlab.drivers.usb_cam.node import UsbCamNode
 from roverlab.errors import RoverlabError
 from roverlab.launch.state import LaunchState, NodeFactory, node_kwargs
 from roverlab.launch.xml import LaunchError, NodeSpec
+from roverlab.perception.face_detector.node import FaceDetectorNode
 
 __all__ = ["DEVICE_NODES"]
 
@@ -37,6 +40,21 @@ def _arbotix(state: LaunchState, spec: NodeSpec) -> Node | None:
         raise LaunchError(f"{spec.source}: {spec.pkg}/{spec.type}: {err}") from err
 
 
+def _plain(make: Callable[..., Node]) -> NodeFactory:
+    """A node built from its ``<node>`` (private params, remaps); a bad configuration is a
+    LaunchError naming the file."""
+
+    def factory(state: LaunchState, spec: NodeSpec) -> Node:
+        try:
+            return make(state.context, node_name=spec.name, **node_kwargs(spec))
+        except (RoverlabError, ValueError) as err:
+            raise LaunchError(f"{spec.source}: {spec.pkg}/{spec.type}: {err}") from err
+
+    return factory
+
+
 DEVICE_NODES: Final[dict[tuple[str, str], NodeFactory]] = {
     ("arbotix_python", "arbotix_driver"): _arbotix,
+    ("usb_cam", "usb_cam_node"): _plain(UsbCamNode),
+    ("face_detector", "face_detector"): _plain(FaceDetectorNode),
 }
