@@ -18,6 +18,7 @@ from typing import Final
 
 from roverlab.core import Node
 from roverlab.drivers.arbotix.node import ArbotixDriver
+from roverlab.drivers.rplidar.node import RplidarNode
 from roverlab.drivers.usb_cam.node import UsbCamNode
 from roverlab.errors import RoverlabError
 from roverlab.launch.state import LaunchState, NodeFactory, node_kwargs
@@ -56,5 +57,7 @@ def _plain(make: Callable[..., Node]) -> NodeFactory:
 DEVICE_NODES: Final[dict[tuple[str, str], NodeFactory]] = {
     ("arbotix_python", "arbotix_driver"): _arbotix,
     ("usb_cam", "usb_cam_node"): _plain(UsbCamNode),
+    ("rplidar_ros", "rplidarNode"): _plain(RplidarNode),
+    ("rplidar_ros", "rplidar_node"): _plain(RplidarNode),
     ("face_detector", "face_detector"): _plain(FaceDetectorNode),
 }
