@@ -171,10 +171,8 @@ class RplidarDevice:
         """Spin the motor: DTR low enables an A1's motor, SET_MOTOR_PWM drives an A2/A3's
         (a device without PWM control ignores it); 0 stops it."""
         port = self._port()
-        try:
+        with contextlib.suppress(serial.SerialException, OSError):  # a pty: no modem lines
             port.dtr = pwm == 0
-        except (serial.SerialException, OSError):
-            pass  # a pty has no modem lines
         self.send(CMD_SET_MOTOR_PWM, struct.pack("<H", pwm))
 
     def start_scan(self) -> None:
