@@ -116,6 +116,11 @@ class EncoderOdometry:
         self._left = self._right = None
         self.state = OdometryState()
 
+    def rebase(self) -> None:
+        """Keep the pose, forget the last counts (after a reconnection the next reading is
+        the new baseline: what the wheels did meanwhile is not counted)."""
+        self._left = self._right = None
+
     def update(self, left_ticks: int, right_ticks: int, dt_s: float) -> OdometryState:
         """Integrate new cumulative counts read ``dt_s`` after the previous ones."""
         if self._left is None or self._right is None:
