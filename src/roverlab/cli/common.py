@@ -17,10 +17,30 @@ from roverlab.core.transport.zenoh import (
     ZenohTransport,
     query_graph,
 )
+from roverlab.errors import RoverlabError
 
-__all__ = ["Connection", "NetworkOptions", "choose_expose", "network_options", "run_context"]
+__all__ = [
+    "Connection",
+    "NetworkOptions",
+    "choose_expose",
+    "is_loopback_endpoint",
+    "network_options",
+    "run_context",
+]
 
 _SETTLE_S = 0.3
+_CONNECT_TIMEOUT_S = 5.0
+_LOOPBACK_HOSTS = ("localhost", "::1", "ip6-localhost")
+
+
+def is_loopback_endpoint(endpoint: str) -> bool:
+    """Whether a Zenoh endpoint (``tcp/127.0.0.1:7447``, ``unixsock-stream/...``) can only
+    be reached from this machine."""
+    proto, _, addr = endpoint.partition("/")
+    if proto.startswith("unixsock"):
+        return True
+    host = addr.split("#")[0].rpartition(":")[0].strip("[]")
+    return host in _LOOPBACK_HOSTS or host.startswith("127.")
 
 
 @dataclass(frozen=True)
@@ -35,8 +55,23 @@ class NetworkOptions:
     tls_cert: str | None = None
     tls_key: str | None = None
     multicast: bool = False
+    insecure: bool = False
 
     def zenoh_options(self) -> ZenohOptions:
+        """The transport settings; an explicit ``--connect`` fails fast (5 s) with a clear
+        error when the other side refuses the session or nothing listens there.
+
+        Raises:
+            RoverlabError: a non-loopback ``--listen`` without ``--user``/``--password``
+                and without ``--insecure``.
+        """
+        exposed = [ep for ep in self.listen if not is_loopback_endpoint(ep)]
+        if exposed and self.user is None and not self.insecure:
+            raise RoverlabError(
+                f"refusing to listen on {', '.join(exposed)} without authentication: anyone "
+                "on that network could read the robot's topics and drive it. Give --user and "
+                "--password (the same on both machines), or --insecure on a network you trust"
+            )
         opts = ZenohOptions(
             listen=self.listen,
             connect=self.connect,
@@ -46,6 +81,7 @@ class NetworkOptions:
             tls_cert=self.tls_cert,
             tls_key=self.tls_key,
             multicast_scouting=self.multicast,
+            connect_timeout_s=_CONNECT_TIMEOUT_S if self.connect else None,
         )
         if not opts.connect and not self.multicast:
             opts = replace(opts, connect=(ensure_daemon(),))

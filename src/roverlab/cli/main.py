@@ -105,6 +105,14 @@ def root(
             "--multicast", help="Find peers by UDP multicast on the LAN (off by default)."
         ),
     ] = False,
+    insecure: Annotated[
+        bool,
+        typer.Option(
+            "--insecure",
+            help="Allow --listen beyond loopback without --user/--password (a trusted "
+            "network only: anyone on it can read and drive the robot).",
+        ),
+    ] = False,
 ) -> None:
     """roverlab: simulate, map, localise, navigate and inspect robots the ROS way."""
     ctx.obj = NetworkOptions(
@@ -116,6 +124,7 @@ def root(
         tls_cert=tls_cert,
         tls_key=tls_key,
         multicast=multicast,
+        insecure=insecure,
     )
 
 

@@ -104,6 +104,9 @@ class ZenohOptions:
         user, password: user/password authentication (both sides must use the same).
         tls_root_ca, tls_cert, tls_key: files for ``tls/`` endpoints (server cert and
             key where this side listens; the CA that signed the other side's cert).
+        connect_timeout_s: fail opening the session when no ``connect`` endpoint accepts
+            it within this time (a wrong password, nobody listening) instead of retrying
+            in the background; None retries forever.
     """
 
     mode: str = "peer"
@@ -115,6 +118,7 @@ class ZenohOptions:
     tls_root_ca: str | None = None
     tls_cert: str | None = None
     tls_key: str | None = None
+    connect_timeout_s: float | None = None
     domain: int = field(default_factory=domain_id)
 
     def to_config(self) -> tuple[zenoh.Config, list[str]]:
@@ -144,6 +148,10 @@ class ZenohOptions:
             put("transport/auth/usrpwd/user", self.user)
             put("transport/auth/usrpwd/password", self.password)
             put("transport/auth/usrpwd/dictionary_file", path)
+        if self.connect_timeout_s is not None and self.connect:
+            ms = int(self.connect_timeout_s * 1000)
+            put("connect/timeout_ms", {"router": -1, "peer": ms, "client": ms})
+            put("connect/exit_on_failure", {"router": False, "peer": True, "client": True})
         if self.tls_root_ca is not None:
             put("transport/link/tls/root_ca_certificate", self.tls_root_ca)
         if self.tls_cert is not None:
@@ -160,7 +168,25 @@ def open_session(options: ZenohOptions) -> tuple[zenoh.Session, list[str]]:
     except Exception as err:
         for path in temps:
             os.unlink(path)
+        if options.connect and "Unable to connect" in str(err):
+            raise TransportError(_connect_failure(options)) from err
         raise TransportError(f"cannot open Zenoh session: {err}") from err
+
+
+def _connect_failure(options: ZenohOptions) -> str:
+    """Why no ``connect`` endpoint took the session: nothing listening, or refused."""
+    endpoints = ", ".join(options.connect)
+    if any(endpoint_reachable(ep, timeout_s=1.0) for ep in options.connect):
+        auth = (
+            "wrong --user/--password"
+            if options.user is not None
+            else "it requires --user and --password"
+        )
+        return f"{endpoints} refused the session: {auth} (or another TLS setup)"
+    return (
+        f"cannot connect to {endpoints}: nothing answers there (is roverlab running on that "
+        "machine with --listen on that address and port?)"
+    )
 
 
 def endpoint_reachable(endpoint: str, timeout_s: float = 0.2) -> bool:
