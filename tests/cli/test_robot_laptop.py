@@ -10,6 +10,7 @@ skipped, saying why, where it cannot (no root, no ``ip``, no netns support).
 
 from __future__ import annotations
 
+import contextlib
 import os
 import shutil
 import signal
@@ -99,10 +100,8 @@ class Namespaces:
             # processes this test started inside the namespace (the robot's daemon)
             pids = _ip("netns", "pids", ns).stdout.split()
             for pid in pids:
-                try:
+                with contextlib.suppress(ProcessLookupError, ValueError):
                     os.kill(int(pid), signal.SIGTERM)
-                except (ProcessLookupError, ValueError):
-                    pass
             _ip("netns", "delete", ns)
 
 
