@@ -52,6 +52,11 @@ app.command(
     context_settings={"allow_extra_args": True, "ignore_unknown_options": True},
 )(run.run)
 app.command("dashboard")(viz_cli.dashboard)
+image_app = typer.Typer(
+    help="Camera images (rqt_image_view) in the dashboard's image panel.", no_args_is_help=True
+)
+image_app.command("view")(viz_cli.image_view)
+app.add_typer(image_app, name="image")
 app.add_typer(urdf_cli.app, name="urdf")
 app.add_typer(map_cli.app, name="map")
 slam_cli.app.command("run")(slam_run.run)

@@ -28,7 +28,8 @@ from roverlab.mapping.hector.node import HectorMapping
 from roverlab.maps.node import MapSaver, MapServer
 from roverlab.msgs import classes as mc
 from roverlab.viz.errors import DashboardError
-from roverlab.viz.launcher import start_rviz
+from roverlab.viz.joints import SLIDER_TOPIC
+from roverlab.viz.launcher import start_image_view, start_rviz
 from roverlab.world import BUNDLED_WORLDS, load_world
 
 __all__ = ["REGISTRY", "LaunchState", "NodeFactory", "register"]
@@ -119,11 +120,22 @@ for _key in (
     ("robot_state_publisher", "state_publisher"),
 ):
     REGISTRY[_key] = _with_description(_make_rsp)
-for _key in (
-    ("joint_state_publisher", "joint_state_publisher"),
-    ("joint_state_publisher_gui", "joint_state_publisher_gui"),
-):
-    REGISTRY[_key] = _with_description(_make_jsp)
+
+
+def _make_jsp_gui(state: LaunchState, spec: NodeSpec, urdf: str) -> Node:
+    """joint_state_publisher_gui: joint_state_publisher that also follows the dashboard's
+    Joints sliders (their topic is added to its ``source_list``)."""
+    sources = list(spec.params.get("source_list") or [])
+    if SLIDER_TOPIC not in sources:
+        sources.append(SLIDER_TOPIC)
+    kwargs = {**_kwargs(spec), "parameter_overrides": {**spec.params, "source_list": sources}}
+    return JointStatePublisher(state.context, robot_description=urdf, node_name=spec.name, **kwargs)
+
+
+REGISTRY[("joint_state_publisher", "joint_state_publisher")] = _with_description(_make_jsp)
+REGISTRY[("joint_state_publisher_gui", "joint_state_publisher_gui")] = _with_description(
+    _make_jsp_gui
+)
 
 
 class StaticTransformPublisher(Node):
@@ -298,9 +310,22 @@ def _rviz(state: LaunchState, spec: NodeSpec) -> Node | None:
         raise LaunchError(f"{spec.source}: rviz: {err}") from err
 
 
-REGISTRY[("rqt_image_view", "rqt_image_view")] = _unavailable(
-    "open `roverlab dashboard` in another terminal: it has the image panel"
-)
+@register("rqt_image_view", "rqt_image_view")
+def _rqt_image_view(state: LaunchState, spec: NodeSpec) -> Node | None:
+    """The dashboard's image panel (``args`` or ``<remap from="image">`` names the topic)."""
+    try:
+        return start_image_view(
+            state.context,
+            spec.args,
+            remaps=spec.remaps,
+            node_name=spec.name,
+            source=spec.source,
+            warn=state.warnings.append,
+        )
+    except DashboardError as err:
+        raise LaunchError(f"{spec.source}: rqt_image_view: {err}") from err
+
+
 for _t in ("teleop_twist_keyboard.py", "teleop_twist_keyboard"):
     REGISTRY[("teleop_twist_keyboard", _t)] = _unavailable(
         "it needs a terminal: run `roverlab teleop` in one"

@@ -32,6 +32,7 @@ from roverlab.errors import RoverlabError
 from roverlab.geometry import Transform3, yaw_from_quat
 from roverlab.maps import save_map
 from roverlab.msgs import (
+    JointState,
     PointStamped,
     PoseStamped,
     PoseWithCovarianceStamped,
@@ -62,6 +63,7 @@ from roverlab.viz.displays import (
     poses_in_fixed,
 )
 from roverlab.viz.errors import DashboardError
+from roverlab.viz.joints import SLIDER_TOPIC, JointSliders
 from roverlab.viz.protocol import (
     INITIALPOSE_COVARIANCE,
     VisualOutline,
@@ -227,6 +229,8 @@ class VizBridge:
         self._received: dict[str, int] = {}
         self._rate_samples: dict[str, deque[tuple[float, int]]] = {}
         self.outlines: Versioned | None = None
+        self.joint_sliders: JointSliders | None = None
+        self._slider_pub: Any = None
         self._description_sub: Any = None
         self._description_topic = ""
         self.config = config if config is not None else default_config(fixed_frame)
@@ -565,6 +569,20 @@ class VizBridge:
     def _on_description(self, msg: Any) -> None:
         model = parse_urdf(str(msg.data), source=self._description_topic)
         self.outlines = Versioned(self._next(), robot_outlines(model))
+        self.joint_sliders = JointSliders(model)
+
+    def set_joint(self, name: str, position: float) -> None:
+        """Move a joint slider and publish every slider on the sliders topic.
+
+        Raises:
+            KeyError: no robot description yet, or no such joint.
+        """
+        if self.joint_sliders is None:
+            raise KeyError("no robot description: no joints to move")
+        self.joint_sliders.set(name, position)
+        if self._slider_pub is None:
+            self._slider_pub = self.node.create_publisher(JointState, SLIDER_TOPIC, 10)
+        self._slider_pub.publish(self.joint_sliders.message(self.node.get_clock().now().to_msg()))
 
     # ---------------------------------------------------------------- queries
     def refresh_remote_graph(self) -> None:
@@ -699,6 +717,7 @@ class VizBridge:
             "fixed_frame": fixed,
             "frames": frames,
             "robot": robot,
+            "joints": self.joint_sliders.to_list() if self.joint_sliders else [],
             "displays": [d.info for d in self.displays],
             "status": self.status(frames, outlines),
             "image_topics": self.image_topics(),
