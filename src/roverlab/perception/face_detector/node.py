@@ -5,7 +5,9 @@ Topics, as face_detector resolves them: ``camera``, ``image_topic``, ``depth_top
 ``<remap from="image_topic" to="image_raw"/>``).
 
 * ``use_rgbd`` false (RGB-only: roverlab's mode for a plain camera; ROS's stereo mode is
-  not implemented): subscribes ``camera/image_topic`` (sensor_msgs/Image). Faces have no
+  not implemented): subscribes ``camera/image_topic`` (sensor_msgs/Image), or the topic
+  ``image`` is remapped to (``<remap from="image" to="/image_raw"/>``, for a camera
+  publishing outside a namespace, as Gazebo's with ``cameraName /``). Faces have no
   known size, so they are ``unknown`` and published only with
   ``do_publish_faces_of_unknown_size: true``, positioned at their image centre
   ``(u, v, 0)`` in pixels, as face_detector does for faces of unknown size.
@@ -42,6 +44,7 @@ from typing import Any
 import numpy as np
 
 from roverlab.core import Context, Node, QoSProfile
+from roverlab.core.graph import resolve_name
 from roverlab.msgs import array_to_image, get_factory, image_to_array
 from roverlab.msgs import classes as mc
 from roverlab.perception.errors import PerceptionError
@@ -148,7 +151,9 @@ class FaceDetectorNode(Node):
                 mc.CameraInfo, _join(camera, "rgb", "camera_info"), self._on_info, 3
             )
         else:
-            self.image_topic = _join(camera, image_topic)
+            image = self.resolve_topic_name("image")
+            remapped = image != resolve_name("image", self.get_namespace(), self.get_name())
+            self.image_topic = image if remapped else _join(camera, image_topic)
         self.create_subscription(mc.Image, self.image_topic, self._on_image, 3)
         self.get_logger().info(
             f"face_detector on {self.image_topic} ({'RGB-D' if self.use_rgbd else 'RGB only'}),"
