@@ -266,3 +266,37 @@ def test_robot_and_laptop_over_a_veth_pair(namespaces: Namespaces, tmp_path: Pat
     assert info["width"] > 0 and info["resolution"] == pytest.approx(0.05)  # type: ignore[index]
     robot.send_signal(signal.SIGINT)
     assert robot.wait(timeout=20) == 0
+
+
+def test_listen_beyond_loopback_needs_authentication() -> None:
+    from roverlab.cli.common import NetworkOptions, is_loopback_endpoint
+    from roverlab.errors import RoverlabError
+
+    assert is_loopback_endpoint("tcp/127.0.0.1:7447") and is_loopback_endpoint("tcp/[::1]:7447")
+    assert is_loopback_endpoint("tcp/localhost:0") and is_loopback_endpoint("unixsock-stream//x")
+    assert not is_loopback_endpoint("tcp/0.0.0.0:7447")
+    assert not is_loopback_endpoint("tcp/192.168.1.41:7447")
+    peer = ("tcp/127.0.0.1:1",)  # an explicit --connect: no daemon is started
+    with pytest.raises(RoverlabError, match=r"refusing to listen on tcp/0\.0\.0\.0:7447"):
+        NetworkOptions(listen=("tcp/0.0.0.0:7447",), connect=peer).zenoh_options()
+    insecure = NetworkOptions(listen=("tcp/0.0.0.0:7447",), connect=peer, insecure=True)
+    assert insecure.zenoh_options().listen == ("tcp/0.0.0.0:7447",)
+    auth = NetworkOptions(
+        listen=("tcp/0.0.0.0:7447",), connect=peer, user="robot", password="s3cret"
+    ).zenoh_options()
+    assert auth.user == "robot" and auth.connect_timeout_s == 5.0
+
+
+def test_connect_to_nothing_is_one_clear_error() -> None:
+    done = subprocess.run(
+        [ROVERLAB, "--connect", "tcp/127.0.0.1:9", "topic", "list"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=False,
+    )
+    assert done.returncode == 2
+    assert done.stderr.strip().splitlines() == [
+        "error: cannot connect to tcp/127.0.0.1:9: nothing answers there (is roverlab running "
+        "on that machine with --listen on that address and port?)"
+    ]
