@@ -27,6 +27,8 @@ from roverlab.mapping.graph.node import SlamKarto, SlamToolbox
 from roverlab.mapping.hector.node import HectorMapping
 from roverlab.maps.node import MapSaver, MapServer
 from roverlab.msgs import classes as mc
+from roverlab.navigation.costmap.node import Costmap2DNode
+from roverlab.navigation.move_base.node import MoveBase
 from roverlab.viz.errors import DashboardError
 from roverlab.viz.joints import SLIDER_TOPIC
 from roverlab.viz.launcher import start_image_view, start_rviz
@@ -284,7 +286,9 @@ REGISTRY[("hector_mapping", "hector_mapping")] = _slam_node(HectorMapping)
 REGISTRY[("slam_toolbox", "async_slam_toolbox_node")] = _slam_node(SlamToolbox)
 REGISTRY[("slam_toolbox", "sync_slam_toolbox_node")] = _slam_node(SlamToolbox)
 REGISTRY[("slam_karto", "slam_karto")] = _slam_node(SlamKarto)
+REGISTRY[("costmap_2d", "costmap_2d_node")] = _slam_node(Costmap2DNode)
 REGISTRY[("amcl", "amcl")] = _slam_node(AmclNode)
+REGISTRY[("move_base", "move_base")] = _slam_node(MoveBase)
 
 
 def _unavailable(reason: str) -> NodeFactory:

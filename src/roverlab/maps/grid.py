@@ -45,7 +45,7 @@ from roverlab.maps.errors import GridError
 from roverlab.msgs import array_to_occupancy_grid
 from roverlab.msgs import classes as mc
 
-__all__ = ["CountGrid", "LogOddsGrid", "ScanRays", "trace_cells"]
+__all__ = ["CountGrid", "LogOddsGrid", "ScanRays", "trace_cells", "trace_segment_cells"]
 
 _jit = numba.njit(cache=True, nogil=True)
 
@@ -107,6 +107,12 @@ def _trace(
             if iy < 0 or iy >= h:
                 break
     return n
+
+
+#: The compiled tracer itself, for other compiled kernels (the costmap's obstacle-layer
+#: clearing): ``trace_segment_cells(gx0, gy0, gx1, gy1, w, h, out) -> n`` writes the flat
+#: indices ``iy * w + ix`` of the cells the segment crosses (cell units, clipped to the grid).
+trace_segment_cells = _trace
 
 
 @_jit

@@ -7,6 +7,7 @@ images and point clouds to arrays, stamps to integer nanoseconds.
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Sequence
 from typing import Any, Final
@@ -26,7 +27,6 @@ from .factory import (
     OccupancyGrid,
     PointCloud2,
     PointField,
-    Pose,
     Quaternion,
     Time,
 )
@@ -40,6 +40,7 @@ __all__ = [
     "pointcloud2_to_rgb",
     "pointcloud2_to_xyz",
     "pose_from_xytheta",
+    "poses_from_xytheta",
     "quaternion_from_yaw",
     "scan_angles",
     "scan_to_points",
@@ -112,7 +113,24 @@ def yaw_from_quaternion(q: Any) -> float:
 
 def pose_from_xytheta(x: float, y: float, theta: float) -> mc.Pose:
     """A planar ``geometry_msgs/Pose``: position ``(x, y, 0)`` in m, heading ``theta`` in rad."""
-    return Pose(position={"x": float(x), "y": float(y)}, orientation=quaternion_from_yaw(theta))
+    half = 0.5 * float(theta)
+    return mc.Pose(
+        mc.Point(float(x), float(y), 0.0),
+        mc.Quaternion(0.0, 0.0, math.sin(half), math.cos(half)),
+    )
+
+
+def poses_from_xytheta(rows: ArrayLike) -> list[mc.Pose]:
+    """Planar ``geometry_msgs/Pose`` messages of ``(N, 3)`` ``x, y, theta`` rows (a particle
+    cloud, a path): one vectorised pass for the trigonometry."""
+    a = np.asarray(rows, dtype=np.float64).reshape(-1, 3)
+    s = np.sin(0.5 * a[:, 2]).tolist()
+    c = np.cos(0.5 * a[:, 2]).tolist()
+    point, quat, pose = mc.Point, mc.Quaternion, mc.Pose
+    return [
+        pose(point(x, y, 0.0), quat(0.0, 0.0, si, ci))
+        for x, y, si, ci in zip(a[:, 0].tolist(), a[:, 1].tolist(), s, c, strict=True)
+    ]
 
 
 def xytheta_from_pose(pose: Any) -> tuple[float, float, float]:

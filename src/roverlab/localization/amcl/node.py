@@ -50,6 +50,7 @@ from roverlab.msgs import (
     PoseWithCovarianceStamped,
     occupancy_grid_to_array,
     pose_from_xytheta,
+    poses_from_xytheta,
     stamp_to_msg,
     xytheta_from_pose,
 )
@@ -401,7 +402,7 @@ class AmclNode(Node):
         poses = self.amcl.pf.poses
         msg = PoseArray(
             header={"frame_id": self.global_frame, "stamp": stamp_to_msg(self.get_clock().now())},
-            poses=[pose_from_xytheta(float(x), float(y), float(a)) for x, y, a in poses],
+            poses=poses_from_xytheta(poses),
         )
         self.cloud_publisher.publish(msg)
 

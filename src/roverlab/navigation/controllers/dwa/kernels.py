@@ -1,0 +1,377 @@
+"""dwa_local_planner's compiled core: the map grids' wavefront and the scoring of every
+rollout in one kernel.
+
+The critics, in DWAPlanner's order, each skipped when its scale is 0 (a negative cost
+rejects the trajectory):
+
+1. oscillation (scale 1): a direction forbidden by the oscillation flags: -5 / -7 / -6;
+2. obstacle (``occdist_scale``): every point's footprint (scaled by the speed factor, see
+   :func:`score_rollouts`) laid on the costmap along its edges; a lethal or unknown cell
+   or a vertex off the map: -6, the centre off the map: -7; the cost is the highest cell
+   cost (the sum with ``sum_scores``); the rollout is also checked for ``stop_time_buffer``
+   seconds beyond its end;
+3. goal front (``goal_distance_bias``): the local-goal grid at the point
+   ``forward_point_distance`` ahead of the last pose (no failure);
+4. alignment (``path_distance_bias``, 0 near the goal): the path grid at that point;
+5. path (``path_distance_bias``): the path grid at the last pose; a point on an obstacle
+   or unreachable cell of the grid: -3 / -2;
+6. goal (``goal_distance_bias``): the local-goal grid at the last pose (same failures);
+7. twirling (``twirling_scale``): ``|vth|``.
+
+Grid critics return -4 for a point off the map.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+from numpy.typing import NDArray
+
+from roverlab.navigation.costmap.kernels import footprint_cost
+
+__all__ = ["rollout", "score_rollouts", "target_distance"]
+
+_jit = numba.njit(cache=True, nogil=True)
+
+LETHAL = 254
+INSCRIBED = 253
+NO_INFO = 255
+
+
+@_jit
+def target_distance(
+    costs: NDArray[np.uint8], seeds: NDArray[np.int64], out: NDArray[np.float64]
+) -> None:
+    """base_local_planner's ``MapGrid::computeTargetDistance``: a 4-connected wavefront
+    from the seed cells (distance 0) counting cells; lethal, inscribed and unknown cells get
+    ``size`` (obstacle) and stop the wave; cells never reached keep ``size + 1``."""
+    h, w = costs.shape
+    size = h * w
+    flat = out.reshape(-1)
+    flat[:] = size + 1
+    mark = np.zeros(size, dtype=np.bool_)
+    queue = np.empty(size + seeds.shape[0], dtype=np.int64)
+    qh = 0
+    qt = 0
+    for k in range(seeds.shape[0]):
+        idx = seeds[k, 1] * w + seeds[k, 0]
+        flat[idx] = 0.0
+        mark[idx] = True
+        queue[qt] = idx
+        qt += 1
+    while qh < qt:
+        cur = queue[qh]
+        qh += 1
+        cx = cur % w
+        cy = cur // w
+        for nb in range(4):
+            if nb == 0:
+                if cx == 0:
+                    continue
+                n = cur - 1
+            elif nb == 1:
+                if cx == w - 1:
+                    continue
+                n = cur + 1
+            elif nb == 2:
+                if cy == 0:
+                    continue
+                n = cur - w
+            else:
+                if cy == h - 1:
+                    continue
+                n = cur + w
+            if mark[n]:
+                continue
+            mark[n] = True
+            c = costs[n // w, n % w]
+            if c in (LETHAL, INSCRIBED, NO_INFO):
+                flat[n] = size
+                continue
+            d = flat[cur] + 1.0
+            if d < flat[n]:
+                flat[n] = d
+            queue[qt] = n
+            qt += 1
+
+
+@_jit
+def rollout(
+    pos: NDArray[np.float64],
+    vel: NDArray[np.float64],
+    target: NDArray[np.float64],
+    sim_time: float,
+    sim_granularity: float,
+    angular_sim_granularity: float,
+    continued_acceleration: bool,
+    acc: NDArray[np.float64],
+    extra_time: float,
+    out: NDArray[np.float64],
+) -> tuple[int, int, float]:
+    """SimpleTrajectoryGenerator's ``generateTrajectory`` for one velocity sample.
+
+    Writes the poses (from the current pose, ``num_steps`` of them) to ``out``, followed by
+    the poses of ``extra_time`` more seconds at the same velocity. Returns
+    ``(num_steps, extra_steps, dt)``; ``num_steps`` 0 if the sample gives no trajectory.
+    """
+    vmag = math.hypot(target[0], target[1])
+    num = int(
+        math.ceil(
+            max(
+                vmag * sim_time / sim_granularity,
+                abs(target[2]) * sim_time / angular_sim_granularity,
+            )
+        )
+    )
+    if num == 0:
+        return 0, 0, 0.0
+    dt = sim_time / num
+    extra = int(math.ceil(extra_time / dt - 1e-9)) if extra_time > 0 else 0
+    cap = out.shape[0]
+    if num + extra > cap:
+        extra = max(0, cap - num)
+        num = min(num, cap)
+    x = pos[0]
+    y = pos[1]
+    th = pos[2]
+    vx = target[0]
+    vy = target[1]
+    vth = target[2]
+    if continued_acceleration:
+        vx, vy, vth = _accelerate(target, vel[0], vel[1], vel[2], acc, dt)
+    for i in range(num + extra):
+        out[i, 0] = x
+        out[i, 1] = y
+        out[i, 2] = th
+        if continued_acceleration and i < num:
+            vx, vy, vth = _accelerate(target, vx, vy, vth, acc, dt)
+        x += (vx * math.cos(th) + vy * math.cos(math.pi / 2 + th)) * dt
+        y += (vx * math.sin(th) + vy * math.sin(math.pi / 2 + th)) * dt
+        th += vth * dt
+    return num, extra, dt
+
+
+@_jit
+def _accelerate(
+    target: NDArray[np.float64],
+    vx: float,
+    vy: float,
+    vth: float,
+    acc: NDArray[np.float64],
+    dt: float,
+) -> tuple[float, float, float]:
+    out = np.empty(3)
+    cur = (vx, vy, vth)
+    for i in range(3):
+        if cur[i] < target[i]:
+            out[i] = min(target[i], cur[i] + acc[i] * dt)
+        else:
+            out[i] = max(target[i], cur[i] - acc[i] * dt)
+    return out[0], out[1], out[2]
+
+
+@_jit
+def _grid_value(
+    grid: NDArray[np.float64], res: float, ox: float, oy: float, x: float, y: float
+) -> float:
+    h, w = grid.shape
+    if x < ox or y < oy:
+        return -1.0
+    mx = int((x - ox) / res)
+    my = int((y - oy) / res)
+    if mx >= w or my >= h:
+        return -1.0
+    return grid[my, mx]
+
+
+@_jit
+def _gen_ok(vx: float, vy: float, vth: float, gen: NDArray[np.float64]) -> bool:
+    eps = 1e-4
+    vmag = math.hypot(vx, vy)
+    if (gen[3] >= 0 and vmag + eps < gen[3]) and (gen[5] >= 0 and abs(vth) + eps < gen[5]):
+        return False
+    return not (gen[4] >= 0 and vmag - eps > gen[4])
+
+
+@_jit
+def _rollout_cap(vx: float, vy: float, vth: float, gen: NDArray[np.float64]) -> int:
+    vmag = math.hypot(vx, vy)
+    num = int(math.ceil(max(vmag * gen[0] / gen[1], abs(vth) * gen[0] / gen[2])))
+    dt = gen[0] / max(num, 1)
+    return num + int(math.ceil(gen[6] / dt)) + 4
+
+
+@_jit
+def score_rollouts(
+    samples: NDArray[np.float64],
+    pos: NDArray[np.float64],
+    vel: NDArray[np.float64],
+    gen: NDArray[np.float64],
+    acc: NDArray[np.float64],
+    continued_acceleration: bool,
+    costs: NDArray[np.uint8],
+    res: float,
+    ox: float,
+    oy: float,
+    path_grid: NDArray[np.float64],
+    goal_grid: NDArray[np.float64],
+    front_grid: NDArray[np.float64],
+    fp: NDArray[np.float64],
+    scales: NDArray[np.float64],
+    scaling: NDArray[np.float64],
+    sum_scores: bool,
+    flags: NDArray[np.bool_],
+    prune: bool,
+    out: NDArray[np.float64],
+) -> int:
+    """Score every velocity sample (the generation checks, then the critics of the module
+    docstring), writing the total cost (``< 0``: rejected; -100: not generated) to ``out``.
+
+    The grid critics and the cheap rejections are computed for every sample first; with
+    ``prune`` the obstacle critic then runs in increasing order of that partial cost and
+    is skipped for samples whose partial cost already exceeds the best total (their
+    ``out`` is that partial cost, a lower bound): the choice is the same as scoring every
+    critic of every sample, as SimpleScoredSamplingPlanner's early break.
+
+    Args:
+        samples: ``(K, 3)`` target velocities ``vx, vy, vth``.
+        pos, vel: the robot's pose (global frame) and velocity (robot frame).
+        gen: ``sim_time, sim_granularity, angular_sim_granularity, min_vel_trans,
+            max_vel_trans, min_vel_theta, stop_time_buffer``.
+        acc: acceleration limits (for ``continued_acceleration``, i.e. ``use_dwa: false``).
+        costs, res, ox, oy: the local costmap.
+        path_grid, goal_grid, front_grid: the map grids (cells; obstacle = size, unreachable
+            = size + 1).
+        fp: ``(M, 2)`` footprint (M < 3: a point / circular robot).
+        scales: ``occdist, goal_front, alignment, path, goal, twirling,
+            forward_point_distance``.
+        scaling: ``scaling_speed, max_vel_trans, max_scaling_factor`` (the footprint grows by
+            up to ``max_scaling_factor`` from ``scaling_speed`` to ``max_vel_trans``).
+        flags: oscillation ``forward_pos_only, forward_neg_only, strafe_pos_only,
+            strafe_neg_only, rot_pos_only, rot_neg_only``.
+
+    Returns:
+        The index of the best sample (first of equal costs), -1 if none is valid.
+    """
+    h, w = costs.shape
+    size = float(h * w)
+    front_s, align_s, path_s, goal_s, twirl_s, fpd = (
+        scales[1], scales[2], scales[3], scales[4], scales[5], scales[6],
+    )  # fmt: skip
+    occ_s = scales[0]
+    nk = samples.shape[0]
+    traj = np.empty((8, 3))
+    buf = np.empty((w + h + 4, 2), dtype=np.int64)
+    partial = np.empty(nk)
+    for k in range(nk):
+        vx = samples[k, 0]
+        vy = samples[k, 1]
+        vth = samples[k, 2]
+        if not _gen_ok(vx, vy, vth, gen):
+            out[k] = -100.0
+            continue
+        need = _rollout_cap(vx, vy, vth, gen)
+        if traj.shape[0] < need:
+            traj = np.empty((need, 3))
+        num, _extra, _dt = rollout(
+            pos, vel, samples[k], gen[0], gen[1], gen[2], continued_acceleration, acc, 0.0, traj
+        )
+        if num == 0:
+            out[k] = -100.0
+            continue
+        if (flags[0] and vx < 0.0) or (flags[1] and vx > 0.0):
+            out[k] = -5.0
+            continue
+        if (flags[2] and vy < 0.0) or (flags[3] and vy > 0.0):
+            out[k] = -7.0
+            continue
+        if (flags[4] and vth < 0.0) or (flags[5] and vth > 0.0):
+            out[k] = -6.0
+            continue
+        total = 0.0
+        failed = 0.0
+        for critic in range(4):
+            if critic == 0:
+                sc, grid, shift, strict = front_s, front_grid, fpd, False
+            elif critic == 1:
+                sc, grid, shift, strict = align_s, path_grid, fpd, False
+            elif critic == 2:
+                sc, grid, shift, strict = path_s, path_grid, 0.0, True
+            else:
+                sc, grid, shift, strict = goal_s, goal_grid, 0.0, True
+            if sc == 0.0:
+                continue
+            v = 0.0
+            for i in range(num):
+                px = traj[i, 0] + shift * math.cos(traj[i, 2])
+                py = traj[i, 1] + shift * math.sin(traj[i, 2])
+                v = _grid_value(grid, res, ox, oy, px, py)
+                if v < 0:
+                    failed = -4.0
+                    break
+                if strict and v == size:
+                    failed = -3.0
+                    break
+                if strict and v == size + 1.0:
+                    failed = -2.0
+                    break
+            if failed < 0:
+                break
+            if v != 0.0:
+                total += v * sc
+        if failed < 0:
+            out[k] = failed
+            continue
+        if twirl_s != 0.0 and vth != 0.0:
+            total += abs(vth) * twirl_s
+        partial[k] = total
+        out[k] = total
+    if occ_s == 0.0:
+        best = -1
+        for k in range(nk):
+            if out[k] >= 0 and (best < 0 or out[k] < out[best]):
+                best = k
+        return best
+    order = np.argsort(np.where(out >= 0, out, np.inf), kind="mergesort")
+    best = -1
+    best_cost = np.inf
+    for q in range(nk):
+        k = order[q]
+        if out[k] < 0:
+            break
+        if prune and partial[k] > best_cost:
+            continue
+        vx = samples[k, 0]
+        vy = samples[k, 1]
+        need = _rollout_cap(vx, vy, samples[k, 2], gen)
+        if traj.shape[0] < need:
+            traj = np.empty((need, 3))
+        num, extra, _dt = rollout(
+            pos, vel, samples[k], gen[0], gen[1], gen[2], continued_acceleration, acc, gen[6],
+            traj,
+        )  # fmt: skip
+        vmag = math.hypot(vx, vy)
+        scale = 1.0
+        if vmag > scaling[0] and scaling[1] > scaling[0]:
+            scale = scaling[2] * (vmag - scaling[0]) / (scaling[1] - scaling[0]) + 1.0
+        oc = 0.0
+        bad = 0.0
+        for i in range(num + extra):
+            fc = footprint_cost(
+                costs, res, ox, oy, traj[i, 0], traj[i, 1], traj[i, 2], fp, scale, buf
+            )
+            if fc < 0:
+                bad = fc
+                break
+            if i < num:
+                oc = oc + fc if sum_scores else max(oc, fc)
+        if bad < 0:
+            out[k] = bad
+            continue
+        out[k] = partial[k] + oc * occ_s
+        if out[k] < best_cost or (out[k] == best_cost and k < best):
+            best_cost = out[k]
+            best = k
+    return best

@@ -1,0 +1,412 @@
+"""dwa_local_planner (``dwa_local_planner/DWAPlannerROS``) as a pure local planner.
+
+Per control cycle, as DWAPlannerROS::computeVelocityCommands:
+
+* the global plan is pruned (``prune_plan``: the points before the first within 1 m of
+  the robot go) and cut to the local costmap (base_local_planner's transformGlobalPlan);
+* the map grids are computed by a wavefront from the local plan (path distance, cells) and
+  from its last point in the costmap (goal distance), and from that point moved
+  ``forward_point_distance`` further from the robot (the nose goal);
+* within ``xy_goal_tolerance`` of the goal (latched with ``latch_xy_goal_tolerance``) the
+  robot stops with its acceleration limits, then rotates in place to the goal's yaw
+  (LatchedStopRotateController), each command checked against the costmap;
+* otherwise velocities are sampled in the dynamic window (``vx/vy/vth_samples`` between the
+  limits and the current velocity -/+ acceleration x ``sim_period``), each simulated for
+  ``sim_time`` and scored by the critics of :mod:`.kernels` in one compiled call; the
+  cheapest valid sample is the command, and the oscillation flags are updated.
+
+Failures raise :class:`NoValidControlError` (the robot must stop) or
+:class:`InvalidPathError`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from roverlab.geometry import SE2
+from roverlab.navigation.controllers.base import (
+    Velocity2D,
+    angle_diff,
+    as_plan,
+    local_plan_window,
+    prune_plan,
+    stopped,
+)
+from roverlab.navigation.controllers.dwa.kernels import rollout, score_rollouts, target_distance
+from roverlab.navigation.controllers.dwa.params import DWAParams
+from roverlab.navigation.costmap.costmap_2d import NO_INFORMATION, Costmap2D
+from roverlab.navigation.errors import InvalidPathError, NoValidControlError
+
+__all__ = ["DWAPlanner", "velocity_iterator"]
+
+
+def velocity_iterator(lo: float, hi: float, num: int) -> list[float]:
+    """base_local_planner's ``VelocityIterator``: ``num`` (>= 2) even samples from ``lo``
+    to ``hi``, with 0 inserted where the samples change sign; ``[lo]`` when equal."""
+    if lo == hi:
+        return [lo]
+    num = max(2, num)
+    step = (hi - lo) / max(1, num - 1)
+    out: list[float] = []
+    nxt = lo
+    for _ in range(num - 1):
+        cur = nxt
+        nxt += step
+        out.append(cur)
+        if cur < 0 < nxt:
+            out.append(0.0)
+    out.append(hi)
+    return out
+
+
+def _adjust_resolution(plan: NDArray[np.float64], resolution: float) -> NDArray[np.float64]:
+    """MapGrid's ``adjustPlanResolution``: points inserted so that none are farther apart
+    than ``resolution``."""
+    if len(plan) < 2:
+        return plan[:, :2]
+    out = [plan[:1, :2]]
+    for a, b in zip(plan[:-1, :2], plan[1:, :2], strict=True):
+        d = float(np.hypot(*(b - a)))
+        if d > resolution:
+            steps = math.ceil(d / resolution)
+            j = np.arange(1, steps)[:, None]
+            out.append(a + j * (b - a) / steps)
+        out.append(b[None, :])
+    return np.concatenate(out)
+
+
+class DWAPlanner:
+    """DWAPlannerROS.
+
+    Args:
+        params: its parameters.
+        footprint: the robot footprint ((N, 2) polygon, robot frame; fewer than 3 points:
+            a circular robot checked at its centre), as the costmap gives it.
+
+    Attributes:
+        local_plan: the plan cut to the costmap, last cycle.
+        trajectory: the chosen trajectory's poses, last cycle (empty when stopping or
+            rotating at the goal).
+        costs: every sample's cost, last cycle (negative: rejected).
+        samples: the velocity samples, last cycle.
+    """
+
+    name = "dwa_local_planner/DWAPlannerROS"
+
+    def __init__(self, params: DWAParams | None = None, *, footprint: ArrayLike = ()) -> None:
+        self.params = params or DWAParams()
+        fp = np.asarray(footprint, dtype=np.float64).reshape(-1, 2)
+        self.footprint = np.ascontiguousarray(fp)
+        self._orig_plan: NDArray[np.float64] | None = None
+        self._plan: NDArray[np.float64] = np.zeros((0, 3))
+        self.local_plan: NDArray[np.float64] = np.zeros((0, 3))
+        self.trajectory: NDArray[np.float64] = np.zeros((0, 3))
+        self.costs: NDArray[np.float64] = np.zeros(0)
+        self.samples: NDArray[np.float64] = np.zeros((0, 3))
+        self._last_pose: SE2 | None = None
+        self._last_twist = Velocity2D()
+        self._xy_latch = False
+        self._rotating = False
+        self._reset_oscillation()
+        self._prev_stationary = SE2()
+        self._grids: tuple[NDArray[np.float64], ...] = ()
+        self._scales = np.zeros(7)
+
+    # ------------------------------------------------------------------ state
+    def _reset_oscillation(self) -> None:
+        # forward_pos_only, forward_neg_only, strafe_pos_only, strafe_neg_only,
+        # rot_pos_only, rot_neg_only
+        self._only = np.zeros(6, dtype=np.bool_)
+        self._seen = {"fwd_pos": False, "fwd_neg": False, "str_pos": False}
+        self._seen.update({"str_neg": False, "rot_pos": False, "rot_neg": False})
+
+    def set_plan(self, plan: ArrayLike) -> None:
+        """A new global plan: resets the goal latch and the oscillation flags."""
+        p = as_plan(plan, "dwa_local_planner")
+        self._orig_plan = p.copy()
+        self._plan = p.copy()
+        self._xy_latch = False
+        self._rotating = False
+        self._reset_oscillation()
+
+    def _goal(self) -> NDArray[np.float64]:
+        if len(self._plan) == 0:
+            raise InvalidPathError("dwa_local_planner: no plan")
+        return self._plan[-1]
+
+    # ------------------------------------------------------------------ goal
+    def _position_reached(self, pose: SE2) -> bool:
+        g = self._goal()
+        p = self.params
+        if (p.latch_xy_goal_tolerance and self._xy_latch) or math.hypot(
+            g[0] - pose.x, g[1] - pose.y
+        ) <= p.xy_goal_tolerance:
+            self._xy_latch = True
+            return True
+        return False
+
+    def is_goal_reached(self, pose: SE2 | None = None, twist: Velocity2D | None = None) -> bool:
+        """Within ``xy_goal_tolerance`` (or latched), within ``yaw_goal_tolerance`` and
+        stopped (``trans_stopped_vel``, ``theta_stopped_vel``)."""
+        pose = pose or self._last_pose
+        twist = twist or self._last_twist
+        if pose is None or len(self._plan) == 0:
+            return False
+        p = self.params
+        g = self._plan[-1]
+        if (p.latch_xy_goal_tolerance and self._xy_latch) or math.hypot(
+            g[0] - pose.x, g[1] - pose.y
+        ) <= p.xy_goal_tolerance:
+            if p.latch_xy_goal_tolerance:
+                self._xy_latch = True
+            if abs(angle_diff(float(g[2]), pose.theta)) <= p.yaw_goal_tolerance:
+                return stopped(twist, p.theta_stopped_vel, p.trans_stopped_vel)
+        return False
+
+    # ------------------------------------------------------------------ grids
+    def _update_local_costs(self, pose: SE2, plan: NDArray[np.float64], cm: Costmap2D) -> None:
+        p = self.params
+        res = cm.resolution
+        adjusted = _adjust_resolution(plan, res)
+        cells = np.floor((adjusted - [cm.origin_x, cm.origin_y]) / res).astype(np.int64)
+        inside = (
+            (adjusted[:, 0] >= cm.origin_x)
+            & (adjusted[:, 1] >= cm.origin_y)
+            & (cells[:, 0] < cm.size_x)
+            & (cells[:, 1] < cm.size_y)
+        )
+        ok = inside.copy()
+        ok[inside] = cm.costs[cells[inside, 1], cells[inside, 0]] != NO_INFORMATION
+        idx = np.nonzero(ok)[0]
+        shape = (cm.size_y, cm.size_x)
+        path_grid = np.empty(shape)
+        goal_grid = np.empty(shape)
+        front_grid = np.empty(shape)
+        if len(idx) == 0:
+            raise InvalidPathError(
+                "dwa_local_planner: none of the points of the global plan are in the local "
+                "costmap and free"
+            )
+        first = idx[0]
+        stop = np.nonzero(~ok[first:])[0]
+        end = len(ok) if len(stop) == 0 else first + int(stop[0])
+        target_distance(cm.costs, np.ascontiguousarray(cells[first:end]), path_grid)
+        # local goal: the last point of the plan's first stretch in the map
+        target_distance(cm.costs, np.ascontiguousarray(cells[end - 1 : end]), goal_grid)
+        g = plan[-1]
+        ang = math.atan2(g[1] - pose.y, g[0] - pose.x)
+        front = plan.copy()
+        front[-1, 0] += p.forward_point_distance * math.cos(ang)
+        front[-1, 1] += p.forward_point_distance * math.sin(ang)
+        fadj = _adjust_resolution(front, res)
+        fcells = np.floor((fadj - [cm.origin_x, cm.origin_y]) / res).astype(np.int64)
+        fin = (
+            (fadj[:, 0] >= cm.origin_x)
+            & (fadj[:, 1] >= cm.origin_y)
+            & (fcells[:, 0] < cm.size_x)
+            & (fcells[:, 1] < cm.size_y)
+        )
+        fok = fin.copy()
+        fok[fin] = cm.costs[fcells[fin, 1], fcells[fin, 0]] != NO_INFORMATION
+        fidx = np.nonzero(fok)[0]
+        if len(fidx):
+            ff = fidx[0]
+            fstop = np.nonzero(~fok[ff:])[0]
+            fend = len(fok) if len(fstop) == 0 else ff + int(fstop[0])
+            target_distance(cm.costs, np.ascontiguousarray(fcells[fend - 1 : fend]), front_grid)
+        else:
+            front_grid[:] = cm.size_x * cm.size_y + 1
+        self._grids = (path_grid, goal_grid, front_grid)
+        unit = res if p.meter_scoring else 1.0
+        path_s = unit * p.path_distance_bias
+        goal_s = unit * p.goal_distance_bias
+        sq = (pose.x - g[0]) ** 2 + (pose.y - g[1]) ** 2
+        align_s = path_s if sq > p.forward_point_distance**2 else 0.0
+        self._scales = np.array(
+            [
+                p.occdist_scale,
+                goal_s,
+                align_s,
+                path_s,
+                goal_s,
+                p.twirling_scale,
+                p.forward_point_distance,
+            ]
+        )
+
+    # ------------------------------------------------------------------ scoring
+    def _score(
+        self, pose: SE2, vel: Velocity2D, samples: NDArray[np.float64], cm: Costmap2D,
+        flags: NDArray[np.bool_], prune: bool = True,
+    ) -> tuple[int, NDArray[np.float64]]:  # fmt: skip
+        p = self.params
+        out = np.empty(len(samples))
+        gen = np.array(
+            [p.sim_time, p.sim_granularity, p.angular_sim_granularity, p.min_vel_trans,
+             p.max_vel_trans, p.min_vel_theta, p.stop_time_buffer]
+        )  # fmt: skip
+        scaling = np.array([p.scaling_speed, p.max_vel_trans, p.max_scaling_factor])
+        best = score_rollouts(
+            np.ascontiguousarray(samples), pose.as_array(), vel.as_array(), gen,
+            np.array([p.acc_lim_x, p.acc_lim_y, p.acc_lim_theta]), not p.use_dwa,
+            cm.costs, cm.resolution, cm.origin_x, cm.origin_y, self._grids[0], self._grids[1],
+            self._grids[2], self.footprint, self._scales, scaling, p.sum_scores, flags, prune,
+            out,
+        )  # fmt: skip
+        return int(best), out
+
+    def _check(self, pose: SE2, vel: Velocity2D, cmd: NDArray[np.float64], cm: Costmap2D) -> bool:
+        """DWAPlanner::checkTrajectory (the oscillation flags are reset, as ROS does)."""
+        self._reset_oscillation()
+        cost = self._score(pose, vel, cmd[None, :], cm, self._only)[1][0]
+        return bool(cost >= 0 or cost == -100.0)
+
+    def _sample_velocities(self, pose: SE2, vel: Velocity2D) -> NDArray[np.float64]:
+        p = self.params
+        g = self._goal()
+        max_th = p.max_vel_theta
+        min_x, max_x = p.min_vel_x, p.max_vel_x
+        min_y, max_y = p.y_limits
+        acc = (p.acc_lim_x, p.acc_lim_y, p.acc_lim_theta)
+        if p.use_dwa:
+            t = p.sim_period
+        else:
+            t = p.sim_time
+            dist = math.hypot(g[0] - pose.x, g[1] - pose.y)
+            max_x = max(min(max_x, dist / p.sim_time), min_x)
+            max_y = max(min(max_y, dist / p.sim_time), min_y)
+        v = vel.as_array()
+        hi = [min(max_x, v[0] + acc[0] * t), min(max_y, v[1] + acc[1] * t)]
+        hi.append(min(max_th, v[2] + acc[2] * t))
+        lo = [max(min_x, v[0] - acc[0] * t), max(min_y, v[1] - acc[1] * t)]
+        lo.append(max(-max_th, v[2] - acc[2] * t))
+        nx, ny, nth = p.samples
+        if min_y == max_y == 0.0:
+            lo[1] = hi[1] = 0.0
+        xs = velocity_iterator(lo[0], hi[0], nx)
+        ys = velocity_iterator(lo[1], hi[1], ny)
+        ths = velocity_iterator(lo[2], hi[2], nth)
+        grid = np.array(np.meshgrid(xs, ys, ths, indexing="ij")).reshape(3, -1).T
+        return np.ascontiguousarray(grid, dtype=np.float64)
+
+    def _update_oscillation(self, pose: SE2, cmd: NDArray[np.float64]) -> None:
+        """OscillationCostFunction::updateOscillationFlags for the chosen command."""
+        p = self.params
+        s = self._seen
+        only = self._only
+        vx, vy, vth = (float(c) for c in cmd)
+        flag = False
+        if vx < 0.0:
+            if s["fwd_pos"]:
+                only[1] = flag = True
+            s["fwd_pos"], s["fwd_neg"] = False, True
+        if vx > 0.0:
+            if s["fwd_neg"]:
+                only[0] = flag = True
+            s["fwd_neg"], s["fwd_pos"] = False, True
+        if abs(vx) <= p.min_vel_trans:
+            if vy < 0:
+                if s["str_pos"]:
+                    only[3] = flag = True
+                s["str_pos"], s["str_neg"] = False, True
+            if vy > 0:
+                if s["str_neg"]:
+                    only[2] = flag = True
+                s["str_neg"], s["str_pos"] = False, True
+            if vth < 0:
+                if s["rot_pos"]:
+                    only[5] = flag = True
+                s["rot_pos"], s["rot_neg"] = False, True
+            if vth > 0:
+                if s["rot_neg"]:
+                    only[4] = flag = True
+                s["rot_neg"], s["rot_pos"] = False, True
+        if flag:
+            self._prev_stationary = pose
+        if only.any():
+            prev = self._prev_stationary
+            d2 = (pose.x - prev.x) ** 2 + (pose.y - prev.y) ** 2
+            if d2 > p.oscillation_reset_dist**2 or abs(pose.theta - prev.theta) > (
+                p.oscillation_reset_angle
+            ):
+                self._reset_oscillation()
+
+    # ------------------------------------------------------------------ control
+    def compute_velocity(
+        self, pose: SE2, twist: Velocity2D, plan: ArrayLike, costmap: Costmap2D
+    ) -> Velocity2D:
+        """The command for this cycle (see the module docstring).
+
+        Raises:
+            InvalidPathError: an empty plan, or none of it in the local costmap.
+            NoValidControlError: every sample rejected, or the stop / rotate command
+                would collide (the robot must stop).
+        """
+        p = self.params
+        new = as_plan(plan, "dwa_local_planner")
+        if self._orig_plan is None or not np.array_equal(new, self._orig_plan):
+            self.set_plan(new)
+        self._last_pose, self._last_twist = pose, twist
+        if p.prune_plan and len(self._plan):
+            # base_local_planner's prunePlan: with no point within 1 m the plan is used up
+            # (until the next setPlan), as in ROS
+            self._plan = prune_plan(pose, self._plan)
+        local = local_plan_window(pose, self._plan, costmap)
+        if len(local) == 0:
+            raise InvalidPathError("dwa_local_planner: received an empty transformed plan")
+        self.local_plan = local
+        self._update_local_costs(pose, local, costmap)
+        self.trajectory = np.zeros((0, 3))
+        if self._position_reached(pose):
+            return self._stop_rotate(pose, twist, costmap)
+        samples = self._sample_velocities(pose, twist)
+        best, costs = self._score(pose, twist, samples, costmap, self._only)
+        self.samples, self.costs = samples, costs
+        if best < 0:
+            raise NoValidControlError(
+                "dwa_local_planner: the dwa local planner failed to find a valid plan, cost "
+                "functions discarded all candidates. This can mean there is an obstacle too "
+                "close to the robot."
+            )
+        cmd = samples[best]
+        self._update_oscillation(pose, cmd)
+        traj = np.empty((int(p.sim_time / min(p.sim_granularity, 1.0)) * 4 + 64, 3))
+        n, _, _ = rollout(
+            pose.as_array(), twist.as_array(), cmd, p.sim_time, p.sim_granularity,
+            p.angular_sim_granularity, not p.use_dwa,
+            np.array([p.acc_lim_x, p.acc_lim_y, p.acc_lim_theta]), 0.0, traj,
+        )  # fmt: skip
+        self.trajectory = traj[:n].copy()
+        return Velocity2D(float(cmd[0]), float(cmd[1]), float(cmd[2]))
+
+    def _stop_rotate(self, pose: SE2, twist: Velocity2D, cm: Costmap2D) -> Velocity2D:
+        """LatchedStopRotateController::computeVelocityCommandsStopRotate."""
+        p = self.params
+        t = p.sim_period
+        goal_th = float(self._goal()[2])
+        if abs(angle_diff(goal_th, pose.theta)) <= p.yaw_goal_tolerance:
+            self._rotating = False  # at the goal's heading: stop (move_base then sees
+            return Velocity2D()  # the robot stopped and ends the goal SUCCEEDED)
+        if not self._rotating and not stopped(twist, p.theta_stopped_vel, p.trans_stopped_vel):
+            vx = math.copysign(max(0.0, abs(twist.vx) - p.acc_lim_x * t), twist.vx)
+            vy = math.copysign(max(0.0, abs(twist.vy) - p.acc_lim_y * t), twist.vy)
+            vth = math.copysign(max(0.0, abs(twist.wz) - p.acc_lim_theta * t), twist.wz)
+            if self._check(pose, twist, np.array([vx, vy, vth]), cm):
+                return Velocity2D(vx, vy, vth)
+            raise NoValidControlError("dwa_local_planner: stopping cmd in collision")
+        self._rotating = True
+        ang = angle_diff(goal_th, pose.theta)
+        v = min(p.max_vel_theta, max(p.min_vel_theta, abs(ang)))
+        max_acc = abs(twist.wz) + p.acc_lim_theta * t
+        min_acc = abs(twist.wz) - p.acc_lim_theta * t
+        v = min(max(abs(v), min_acc), max_acc)
+        v = min(math.sqrt(2 * p.acc_lim_theta * abs(ang)), abs(v))
+        v = min(p.max_vel_theta, max(p.min_vel_theta, v))
+        if ang < 0:
+            v = -v
+        if self._check(pose, twist, np.array([0.0, 0.0, v]), cm):
+            return Velocity2D(0.0, 0.0, v)
+        raise NoValidControlError("dwa_local_planner: rotation cmd in collision")

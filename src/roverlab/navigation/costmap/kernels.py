@@ -1,0 +1,332 @@
+"""Compiled costmap kernels: Bresenham lines, convex fill, ray clearing, marking, inflation.
+
+All grids are ``(size_y, size_x)`` uint8 arrays in ``nav_msgs/OccupancyGrid`` order (row =
+y). Cell coordinates are ``(mx, my)`` integers; world coordinates are turned into cell
+units by the callers.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+from numpy.typing import NDArray
+
+from roverlab.maps.grid import trace_segment_cells
+
+__all__ = [
+    "bresenham",
+    "clear_rays",
+    "convex_fill",
+    "footprint_cost",
+    "inflate",
+    "line_cost",
+    "mark_points",
+]
+
+_jit = numba.njit(cache=True, nogil=True)
+
+LETHAL = 254
+INSCRIBED = 253
+NO_INFO = 255
+
+
+@_jit
+def bresenham(x0: int, y0: int, x1: int, y1: int, max_length: int, out: NDArray[np.int64]) -> int:
+    """costmap_2d's ``raytraceLine``: the cells of the Bresenham line from ``(x0, y0)`` to
+    ``(x1, y1)``, at most ``max_length`` steps along the dominant axis, both ends included.
+
+    Writes ``(mx, my)`` rows into ``out`` (capacity ``max(|dx|, |dy|) + 1``); returns the
+    count.
+    """
+    dx = x1 - x0
+    dy = y1 - y0
+    adx = abs(dx)
+    ady = abs(dy)
+    sx = 1 if dx > 0 else -1
+    sy = 1 if dy > 0 else -1
+    dist = math.hypot(dx, dy)
+    scale = 1.0 if dist == 0.0 else min(1.0, max_length / dist)
+    x = x0
+    y = y0
+    n = 0
+    if adx >= ady:
+        err = adx // 2
+        end = min(int(scale * adx), adx)
+        for _ in range(end):
+            out[n, 0] = x
+            out[n, 1] = y
+            n += 1
+            x += sx
+            err += ady
+            if err >= adx:
+                y += sy
+                err -= adx
+    else:
+        err = ady // 2
+        end = min(int(scale * ady), ady)
+        for _ in range(end):
+            out[n, 0] = x
+            out[n, 1] = y
+            n += 1
+            y += sy
+            err += adx
+            if err >= ady:
+                x += sx
+                err -= ady
+    out[n, 0] = x
+    out[n, 1] = y
+    return n + 1
+
+
+@_jit
+def convex_fill(grid: NDArray[np.uint8], poly: NDArray[np.int64], value: int) -> None:
+    """costmap_2d's ``convexFillCells`` + set: every cell of the outline of the convex
+    polygon ``poly`` ((M, 2) cells, M >= 3, all inside the grid) and between its lowest and
+    highest outline cell of each column gets ``value``."""
+    m = poly.shape[0]
+    xmin = poly[0, 0]
+    xmax = poly[0, 0]
+    for k in range(m):
+        xmin = min(xmin, poly[k, 0])
+        xmax = max(xmax, poly[k, 0])
+    ncol = xmax - xmin + 1
+    lo = np.full(ncol, 1 << 30, dtype=np.int64)
+    hi = np.full(ncol, -1, dtype=np.int64)
+    cap = 0
+    for k in range(m):
+        j = (k + 1) % m
+        cap = max(cap, abs(poly[j, 0] - poly[k, 0]), abs(poly[j, 1] - poly[k, 1]))
+    buf = np.empty((cap + 2, 2), dtype=np.int64)
+    for k in range(m):
+        j = (k + 1) % m
+        n = bresenham(poly[k, 0], poly[k, 1], poly[j, 0], poly[j, 1], 1 << 30, buf)
+        for q in range(n):
+            c = buf[q, 0] - xmin
+            yy = buf[q, 1]
+            lo[c] = min(lo[c], yy)
+            hi[c] = max(hi[c], yy)
+    for c in range(ncol):
+        for yy in range(lo[c], hi[c] + 1):
+            grid[yy, c + xmin] = value
+
+
+@_jit
+def line_cost(
+    grid: NDArray[np.uint8], x0: int, y0: int, x1: int, y1: int, buf: NDArray[np.int64]
+) -> float:
+    """base_local_planner's ``CostmapModel::lineCost``: the highest cost along the Bresenham
+    line, -1 at a lethal or unknown cell (both ends included)."""
+    n = bresenham(x0, y0, x1, y1, 1 << 30, buf)
+    best = 0.0
+    for q in range(n):
+        c = grid[buf[q, 1], buf[q, 0]]
+        if c in (LETHAL, NO_INFO):
+            return -1.0
+        if c > best:
+            best = float(c)
+    return best
+
+
+@_jit
+def clear_rays(
+    grid: NDArray[np.uint8],
+    gx0: float,
+    gy0: float,
+    ends: NDArray[np.float64],
+    max_cells: float,
+    free_value: int,
+    buf: NDArray[np.int64],
+) -> None:
+    """Free every cell each ray ``(gx0, gy0) -> ends[k]`` (cell units) crosses, up to
+    ``max_cells`` from the origin; the rays are traced by roverlab's shared grid tracer
+    (:func:`roverlab.maps.grid.trace_segment_cells`) and clipped to the grid."""
+    h, w = grid.shape
+    flat = grid.reshape(-1)
+    for k in range(ends.shape[0]):
+        ex = ends[k, 0]
+        ey = ends[k, 1]
+        dx = ex - gx0
+        dy = ey - gy0
+        d = math.hypot(dx, dy)
+        if d > max_cells and d > 0.0:
+            s = max_cells / d
+            ex = gx0 + dx * s
+            ey = gy0 + dy * s
+        n = trace_segment_cells(gx0, gy0, ex, ey, w, h, buf)
+        for q in range(n):
+            flat[buf[q]] = free_value
+
+
+@_jit
+def mark_points(
+    grid: NDArray[np.uint8],
+    cells: NDArray[np.int64],
+    value: int,
+) -> None:
+    """Set ``grid[my, mx] = value`` for each ``(mx, my)`` row of ``cells``."""
+    for k in range(cells.shape[0]):
+        grid[cells[k, 1], cells[k, 0]] = value
+
+
+@_jit
+def inflate(
+    master: NDArray[np.uint8],
+    x0: int,
+    y0: int,
+    xn: int,
+    yn: int,
+    radius: int,
+    bin_of: NDArray[np.int64],
+    cost_of: NDArray[np.uint8],
+    nbins: int,
+    inflate_unknown: bool,
+    seen: NDArray[np.bool_],
+    node_cell: NDArray[np.int64],
+    node_src: NDArray[np.int64],
+    node_next: NDArray[np.int64],
+    bin_head: NDArray[np.int64],
+    bin_tail: NDArray[np.int64],
+) -> int:
+    """costmap_2d's ``InflationLayer::updateCosts`` on the window ``[x0, xn) x [y0, yn)``
+    (already grown by the inflation radius by the caller).
+
+    Lethal cells of the window seed distance bin 0; cells are then taken bin by bin in
+    increasing distance to their source obstacle (``bin_of[|dx|, |dy|]`` is the rank of
+    ``hypot(dx, dy)`` among the distances within ``radius``, -1 beyond), each cell takes
+    ``cost_of[|dx|, |dy|]`` (max with its old cost; an unknown cell only takes inscribed
+    and lethal costs, or any non-zero cost with ``inflate_unknown``) and offers its four
+    neighbours with the same source. A cell is taken once (``seen``); a cell offered to a
+    bin already passed is not revisited, as ROS's ordered bins. Returns the cells taken.
+    """
+    h, w = master.shape
+    flat = master.reshape(-1)
+    seen[:] = False
+    bin_head[:nbins] = -1
+    bin_tail[:nbins] = -1
+    cap = node_cell.shape[0]
+    nn = 0
+    for j in range(y0, yn):
+        for i in range(x0, xn):
+            idx = j * w + i
+            if flat[idx] == LETHAL and nn < cap:
+                node_cell[nn] = idx
+                node_src[nn] = idx
+                node_next[nn] = -1
+                if bin_tail[0] < 0:
+                    bin_head[0] = nn
+                else:
+                    node_next[bin_tail[0]] = nn
+                bin_tail[0] = nn
+                nn += 1
+    taken = 0
+    for b in range(nbins):
+        k = bin_head[b]
+        while k >= 0:
+            idx = node_cell[k]
+            if not seen[idx]:
+                seen[idx] = True
+                taken += 1
+                mx = idx % w
+                my = idx // w
+                src = node_src[k]
+                sx = src % w
+                sy = src // w
+                cost = cost_of[abs(mx - sx), abs(my - sy)]
+                old = flat[idx]
+                if old == NO_INFO and (
+                    (inflate_unknown and cost > 0) or (not inflate_unknown and cost >= INSCRIBED)
+                ):
+                    flat[idx] = cost
+                else:
+                    flat[idx] = max(old, cost)
+                for nb in range(4):
+                    if nb == 0:
+                        if mx == 0:
+                            continue
+                        nidx = idx - 1
+                    elif nb == 1:
+                        if my == 0:
+                            continue
+                        nidx = idx - w
+                    elif nb == 2:
+                        if mx == w - 1:
+                            continue
+                        nidx = idx + 1
+                    else:
+                        if my == h - 1:
+                            continue
+                        nidx = idx + w
+                    if seen[nidx]:
+                        continue
+                    nb_bin = bin_of[abs(nidx % w - sx), abs(nidx // w - sy)]
+                    if nb_bin < 0 or nn >= cap:
+                        continue
+                    node_cell[nn] = nidx
+                    node_src[nn] = src
+                    node_next[nn] = -1
+                    if bin_tail[nb_bin] < 0:
+                        bin_head[nb_bin] = nn
+                    else:
+                        node_next[bin_tail[nb_bin]] = nn
+                    bin_tail[nb_bin] = nn
+                    nn += 1
+            k = node_next[k]
+    return taken
+
+
+@_jit
+def footprint_cost(
+    costs: NDArray[np.uint8],
+    res: float,
+    ox: float,
+    oy: float,
+    x: float,
+    y: float,
+    th: float,
+    fp: NDArray[np.float64],
+    scale: float,
+    buf: NDArray[np.int64],
+) -> float:
+    """base_local_planner's ``footprintCost`` at ``(x, y, th)`` (CostmapModel's edge
+    rasterisation of the footprint ``fp`` scaled by ``scale``): the highest cost on its
+    outline (and its centre cell), or -6 when a cell is lethal or unknown or the footprint
+    leaves the grid. ``buf`` is scratch space for the Bresenham cells."""
+    h, w = costs.shape
+    if x < ox or y < oy:
+        return -6.0
+    cx = int((x - ox) / res)
+    cy = int((y - oy) / res)
+    if cx >= w or cy >= h:
+        return -6.0
+    center = float(costs[cy, cx])
+    m = fp.shape[0]
+    if m < 3:
+        c = costs[cy, cx]
+        if c in (LETHAL, INSCRIBED, NO_INFO):
+            return -6.0
+        return center
+    c = math.cos(th)
+    s = math.sin(th)
+    best = 0.0
+    px0 = 0
+    py0 = 0
+    for k in range(m + 1):
+        j = k % m
+        wx = x + scale * (fp[j, 0] * c - fp[j, 1] * s)
+        wy = y + scale * (fp[j, 0] * s + fp[j, 1] * c)
+        if wx < ox or wy < oy:
+            return -6.0
+        mx = int((wx - ox) / res)
+        my = int((wy - oy) / res)
+        if mx >= w or my >= h:
+            return -6.0
+        if k > 0:
+            lc = line_cost(costs, px0, py0, mx, my, buf)
+            if lc < 0:
+                return -6.0
+            best = max(best, lc)
+        px0 = mx
+        py0 = my
+    return max(best, center)

@@ -1,0 +1,369 @@
+"""costmap_2d's ``ObstacleLayer``: obstacles marked and cleared from sensor observations.
+
+Each observation source (``observation_sources: "scan bump"``) keeps an
+:class:`ObservationBuffer` of point clouds in the costmap's global frame, each with the
+sensor origin, filtered to ``[min_obstacle_height, max_obstacle_height]``. At every update
+(:meth:`ObstacleLayer.update_bounds`):
+
+1. the layer's grid follows the robot (rolling window);
+2. every *clearing* observation frees the cells along the ray from the sensor origin to
+   each point, up to ``raytrace_range`` (roverlab's shared compiled grid tracer; ROS uses
+   Bresenham);
+3. every *marking* observation marks as lethal the cell of each point lower than the
+   layer's ``max_obstacle_height`` and closer (3-D) than ``obstacle_range`` to the sensor;
+4. the robot's footprint is cleared (``footprint_clearing_enabled``).
+
+The layer's costs go to the master by ``combination_method`` (0 overwrite, 1 maximum, any
+other value: not at all). ``observation_persistence`` keeps observations that long (0: only
+the latest); ``expected_update_rate`` makes the layer not current when a source is late.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from roverlab.navigation.costmap.costmap_2d import (
+    FREE_SPACE,
+    LETHAL_OBSTACLE,
+    NO_INFORMATION,
+    Costmap2D,
+)
+from roverlab.navigation.costmap.footprint import transform_footprint
+from roverlab.navigation.costmap.kernels import clear_rays, mark_points
+from roverlab.navigation.costmap.layered import Bounds, CostmapLayer
+from roverlab.navigation.errors import CostmapError
+from roverlab.navigation.params import check
+
+__all__ = [
+    "DATA_TYPES",
+    "Observation",
+    "ObservationBuffer",
+    "ObservationSourceParams",
+    "ObstacleLayer",
+    "ObstacleLayerParams",
+    "project_scan",
+]
+
+#: The ``data_type`` values an observation source may have.
+DATA_TYPES = ("LaserScan", "PointCloud2", "PointCloud")
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ObservationSourceParams:
+    """One observation source (ROS names and defaults of costmap_2d's obstacle layer)."""
+
+    name: str
+    topic: str = ""
+    sensor_frame: str = ""
+    observation_persistence: float = 0.0
+    expected_update_rate: float = 0.0
+    data_type: str = "PointCloud"
+    min_obstacle_height: float = 0.0
+    max_obstacle_height: float = 2.0
+    inf_is_valid: bool = False
+    clearing: bool = False
+    marking: bool = True
+    obstacle_range: float = 2.5
+    raytrace_range: float = 3.0
+
+    def __post_init__(self) -> None:
+        w = f"obstacle_layer source {self.name}"
+        check(
+            self.data_type in DATA_TYPES,
+            f"{w}: data_type must be one of {', '.join(DATA_TYPES)}, got {self.data_type!r}",
+        )
+        check(self.observation_persistence >= 0, f"{w}: observation_persistence must be >= 0")
+        check(self.expected_update_rate >= 0, f"{w}: expected_update_rate must be >= 0")
+        check(
+            self.min_obstacle_height <= self.max_obstacle_height,
+            f"{w}: min_obstacle_height must be <= max_obstacle_height",
+        )
+        check(self.obstacle_range >= 0, f"{w}: obstacle_range must be >= 0")
+        check(self.raytrace_range >= 0, f"{w}: raytrace_range must be >= 0")
+
+    @property
+    def topic_name(self) -> str:
+        """The topic (the source's name when ``topic`` is not set)."""
+        return self.topic or self.name
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ObstacleLayerParams:
+    """The obstacle layer's parameters (ROS names and defaults).
+
+    ``track_unknown_space`` None means the costmap's own setting, as costmap_2d.
+    """
+
+    enabled: bool = True
+    track_unknown_space: bool | None = None
+    max_obstacle_height: float = 2.0
+    footprint_clearing_enabled: bool = True
+    combination_method: int = 1
+    observation_sources: tuple[ObservationSourceParams, ...] = field(default_factory=tuple)
+
+    def __post_init__(self) -> None:
+        names = [s.name for s in self.observation_sources]
+        check(len(set(names)) == len(names), "obstacle_layer: observation source listed twice")
+
+
+@dataclass(frozen=True, slots=True)
+class Observation:
+    """Points seen by one sensor at one time, in the costmap's global frame.
+
+    Attributes:
+        origin: ``(x, y, z)`` of the sensor, m.
+        points: ``(N, 3)`` float64 points, m.
+        obstacle_range: marking range of the source, m.
+        raytrace_range: clearing range of the source, m.
+        stamp_s: the sensor data's time, s.
+    """
+
+    origin: NDArray[np.float64]
+    points: NDArray[np.float64]
+    obstacle_range: float
+    raytrace_range: float
+    stamp_s: float
+
+
+def project_scan(
+    ranges: ArrayLike,
+    angles: ArrayLike,
+    range_min: float,
+    range_max: float,
+    *,
+    inf_is_valid: bool = False,
+) -> NDArray[np.float64]:
+    """laser_geometry's projection of a LaserScan: ``(N, 3)`` points in the laser frame.
+
+    Readings in ``[range_min, range_max)`` are kept (NaN dropped). With ``inf_is_valid``
+    an infinite reading counts as ``range_max - 0.0001`` (costmap_2d's
+    ``laserScanValidInfCallback``): it clears but does not mark.
+    """
+    r = np.asarray(ranges, dtype=np.float64).ravel()
+    a = np.asarray(angles, dtype=np.float64).ravel()
+    if r.shape != a.shape:
+        raise CostmapError(f"laser scan: {r.size} ranges but {a.size} angles")
+    if inf_is_valid:
+        r = np.where(np.isposinf(r), range_max - 1e-4, r)
+    with np.errstate(invalid="ignore"):
+        keep = (r >= range_min) & (r < range_max)
+    r, a = r[keep], a[keep]
+    return np.column_stack([r * np.cos(a), r * np.sin(a), np.zeros_like(r)])
+
+
+class ObservationBuffer:
+    """costmap_2d's ``ObservationBuffer`` for one source."""
+
+    def __init__(self, params: ObservationSourceParams) -> None:
+        self.params = params
+        self.observations: list[Observation] = []
+        self.last_updated_s: float | None = None
+
+    def buffer_points(
+        self, origin: ArrayLike, points: ArrayLike, stamp_s: float, now_s: float
+    ) -> None:
+        """Add a cloud (global frame) seen from ``origin`` at ``stamp_s``; ``now_s`` is the
+        clock time (for ``expected_update_rate``)."""
+        o = np.asarray(origin, dtype=np.float64).reshape(3)
+        pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+        if not np.isfinite(o).all():
+            raise CostmapError(f"observation {self.params.name}: sensor origin is not finite")
+        p = self.params
+        z = pts[:, 2]
+        with np.errstate(invalid="ignore"):
+            keep = (z <= p.max_obstacle_height) & (z >= p.min_obstacle_height)
+        keep &= np.isfinite(pts).all(axis=1)
+        self.observations.insert(
+            0, Observation(o, pts[keep], p.obstacle_range, p.raytrace_range, float(stamp_s))
+        )
+        self.last_updated_s = float(now_s)
+        self._purge()
+
+    def _purge(self) -> None:
+        if not self.observations:
+            return
+        keep = self.params.observation_persistence
+        if keep == 0.0:
+            del self.observations[1:]
+            return
+        latest = self.last_updated_s if self.last_updated_s is not None else 0.0
+        self.observations = [o for o in self.observations if latest - o.stamp_s <= keep]
+
+    def get_observations(self) -> list[Observation]:
+        """The observations kept (newest first)."""
+        self._purge()
+        return list(self.observations)
+
+    def is_current(self, now_s: float) -> bool:
+        """Updated within ``expected_update_rate`` (always, when it is 0)."""
+        rate = self.params.expected_update_rate
+        if rate == 0.0:
+            return True
+        return self.last_updated_s is not None and now_s - self.last_updated_s <= rate
+
+    def clear(self) -> None:
+        self.observations.clear()
+
+
+class ObstacleLayer(CostmapLayer):
+    """The obstacle layer.
+
+    Args:
+        name: plugin name (``obstacle_layer``).
+        params: its parameters (with its observation sources).
+
+    Attributes:
+        buffers: the observation buffer of each source, by source name.
+        sensor_warnings: messages about observations that could not be used (the node
+            logs and clears them).
+    """
+
+    def __init__(self, name: str, params: ObstacleLayerParams) -> None:
+        super().__init__(name, enabled=params.enabled)
+        self.params = params
+        self.buffers = {s.name: ObservationBuffer(s) for s in params.observation_sources}
+        self.sensor_warnings: list[str] = []
+        self._footprint = np.zeros((0, 2))
+        self._trace_buf = np.empty(0, dtype=np.int64)
+
+    def on_initialize(self) -> None:
+        track = self.params.track_unknown_space
+        if track is None:
+            track = self.layered.track_unknown_space
+        self.grid.default_value = NO_INFORMATION if track else FREE_SPACE
+
+    def reset(self) -> None:
+        super().reset()
+        for b in self.buffers.values():
+            b.clear()
+
+    def is_current(self, now_s: float) -> bool:
+        return all(
+            b.is_current(now_s)
+            for b in self.buffers.values()
+            if b.params.marking or b.params.clearing
+        )
+
+    def add_observation(
+        self, source: str, origin: ArrayLike, points: ArrayLike, stamp_s: float, now_s: float
+    ) -> None:
+        """Buffer a cloud of source ``source`` (global frame, seen from ``origin``)."""
+        try:
+            buf = self.buffers[source]
+        except KeyError:
+            raise CostmapError(f"{self.name}: no observation source {source!r}") from None
+        buf.buffer_points(origin, points, stamp_s, now_s)
+
+    # ------------------------------------------------------------------ updates
+    def update_bounds(
+        self, robot_x: float, robot_y: float, robot_yaw: float, bounds: Bounds, now_s: float
+    ) -> None:
+        g = self.grid
+        if self.layered.rolling_window:
+            g.update_origin(robot_x - g.size_in_meters_x / 2.0, robot_y - g.size_in_meters_y / 2.0)
+        self.use_extra_bounds(bounds)
+        for buf in self.buffers.values():
+            if buf.params.clearing:
+                for obs in buf.get_observations():
+                    self._raytrace_freespace(obs, bounds)
+        for buf in self.buffers.values():
+            if buf.params.marking:
+                for obs in buf.get_observations():
+                    self._mark(obs, bounds)
+        if self.params.footprint_clearing_enabled and len(self.layered.footprint) >= 3:
+            self._footprint = transform_footprint(
+                robot_x, robot_y, robot_yaw, self.layered.footprint
+            )
+            for x, y in self._footprint:
+                bounds.touch(float(x), float(y))
+
+    def _mark(self, obs: Observation, bounds: Bounds) -> None:
+        pts = obs.points
+        if len(pts) == 0:
+            return
+        g = self.grid
+        d2 = np.sum((pts - obs.origin) ** 2, axis=1)
+        keep = (pts[:, 2] <= self.params.max_obstacle_height) & (
+            d2 < obs.obstacle_range * obs.obstacle_range
+        )
+        keep &= (pts[:, 0] >= g.origin_x) & (pts[:, 1] >= g.origin_y)
+        p = pts[keep]
+        mx = ((p[:, 0] - g.origin_x) / g.resolution).astype(np.int64)
+        my = ((p[:, 1] - g.origin_y) / g.resolution).astype(np.int64)
+        inside = (mx < g.size_x) & (my < g.size_y)
+        if not inside.any():
+            return
+        mark_points(g.costs, np.column_stack([mx[inside], my[inside]]), LETHAL_OBSTACLE)
+        p = p[inside]
+        bounds.touch(float(p[:, 0].min()), float(p[:, 1].min()))
+        bounds.touch(float(p[:, 0].max()), float(p[:, 1].max()))
+
+    def _raytrace_freespace(self, obs: Observation, bounds: Bounds) -> None:
+        g = self.grid
+        ox, oy = float(obs.origin[0]), float(obs.origin[1])
+        if g.world_to_map(ox, oy) is None:
+            self.sensor_warnings.append(
+                f"The origin for the sensor at ({ox:.2f}, {oy:.2f}) is out of map bounds. "
+                "So, the costmap cannot raytrace for it."
+            )
+            return
+        bounds.touch(ox, oy)
+        pts = obs.points[:, :2]
+        if len(pts) == 0:
+            return
+        x0, y0 = g.origin_x, g.origin_y
+        x1 = x0 + g.size_x * g.resolution
+        y1 = y0 + g.size_y * g.resolution
+        wx, wy = pts[:, 0].copy(), pts[:, 1].copy()
+        a, b = wx - ox, wy - oy
+        with np.errstate(divide="ignore", invalid="ignore"):
+            # clip each ray to the map, in costmap_2d's order
+            m = wx < x0
+            t = (x0 - ox) / a
+            wx, wy = np.where(m, x0, wx), np.where(m, oy + b * t, wy)
+            m = wy < y0
+            t = (y0 - oy) / b
+            wx, wy = np.where(m, ox + a * t, wx), np.where(m, y0, wy)
+            m = wx > x1
+            t = (x1 - ox) / a
+            wx, wy = np.where(m, x1 - 0.001, wx), np.where(m, oy + b * t, wy)
+            m = wy > y1
+            t = (y1 - oy) / b
+            wx, wy = np.where(m, ox + a * t, wx), np.where(m, y1 - 0.001, wy)
+        ok = np.isfinite(wx) & np.isfinite(wy) & (wx >= x0) & (wy >= y0) & (wx < x1) & (wy < y1)
+        wx, wy = wx[ok], wy[ok]
+        if len(wx) == 0:
+            return
+        need = g.size_x + g.size_y + 4
+        if self._trace_buf.shape[0] < need:
+            self._trace_buf = np.empty(need, dtype=np.int64)
+        ends = np.column_stack([(wx - x0) / g.resolution, (wy - y0) / g.resolution])
+        clear_rays(
+            g.costs,
+            (ox - x0) / g.resolution,
+            (oy - y0) / g.resolution,
+            np.ascontiguousarray(ends),
+            obs.raytrace_range / g.resolution,
+            FREE_SPACE,
+            self._trace_buf,
+        )
+        # updateRaytraceBounds: each ray's end, cut at raytrace_range
+        dx, dy = wx - ox, wy - oy
+        full = np.hypot(dx, dy)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            scale = np.where(full > 0, np.minimum(1.0, obs.raytrace_range / full), 1.0)
+        ex, ey = ox + dx * scale, oy + dy * scale
+        bounds.touch(float(ex.min()), float(ey.min()))
+        bounds.touch(float(ex.max()), float(ey.max()))
+
+    def update_costs(self, master: Costmap2D, x0: int, y0: int, xn: int, yn: int) -> None:
+        if self.params.footprint_clearing_enabled and len(self._footprint) >= 3:
+            self.grid.set_convex_polygon_cost(self._footprint, FREE_SPACE)
+        method = self.params.combination_method
+        if method == 0:
+            self.update_with_overwrite(master, x0, y0, xn, yn)
+        elif method == 1:
+            self.update_with_max(master, x0, y0, xn, yn)

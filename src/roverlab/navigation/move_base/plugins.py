@@ -1,0 +1,152 @@
+"""move_base's plugins by their ROS names: global planners, local planners, recoveries.
+
+Pure factories: each takes the plugin's ROS parameters (what the node finds under
+``~NAME/``) and returns the algorithm object, or raises NavigationParamsError naming the
+plugin and the parameter.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from numpy.typing import ArrayLike
+
+from roverlab.navigation.controllers import (
+    ControllerProtocol,
+    DWAParams,
+    DWAPlanner,
+    TebParams,
+    TebPlanner,
+)
+from roverlab.navigation.errors import NavigationParamsError
+from roverlab.navigation.move_base.recovery import (
+    ClearCostmapRecovery,
+    RotateRecovery,
+    RotateRecoveryParams,
+)
+from roverlab.navigation.planners import (
+    GlobalPlanner,
+    GlobalPlannerParams,
+    NavfnParams,
+    NavfnPlanner,
+    PlannerProtocol,
+)
+
+__all__ = [
+    "LocalPlannerLimits",
+    "make_global_planner",
+    "make_local_planner",
+    "make_recovery",
+    "plugin_short_name",
+]
+
+
+def plugin_short_name(plugin: str) -> str:
+    """``NavfnROS`` of ``navfn/NavfnROS``: the namespace its parameters live in."""
+    return plugin.rsplit("/", 1)[-1]
+
+
+def make_global_planner(
+    plugin: str, values: Mapping[str, Any]
+) -> tuple[PlannerProtocol, tuple[str, ...]]:
+    """The global planner ``plugin`` with its parameters; also the warnings to log."""
+    if plugin == "navfn/NavfnROS":
+        p, warnings = NavfnParams.from_ros(values)
+        return NavfnPlanner(p), warnings
+    if plugin == "global_planner/GlobalPlanner":
+        gp, warnings = GlobalPlannerParams.from_ros(values)
+        return GlobalPlanner(gp), warnings
+    raise NavigationParamsError(f"move_base: unknown base_global_planner {plugin!r}")
+
+
+@dataclass(frozen=True)
+class LocalPlannerLimits:
+    """What rotate_recovery borrows from the local planner when its own are not set."""
+
+    acc_lim_th: float
+    max_rotational_vel: float
+    min_in_place_rotational_vel: float
+    yaw_goal_tolerance: float
+
+
+def make_local_planner(
+    plugin: str, values: Mapping[str, Any], *, footprint: ArrayLike, controller_frequency: float
+) -> tuple[ControllerProtocol, LocalPlannerLimits, tuple[str, ...]]:
+    """The local planner ``plugin`` with its parameters (``controller_frequency`` is
+    move_base's, as ROS's local planners search it up), its rotation limits, warnings."""
+    if plugin in ("dwa_local_planner/DWAPlannerROS", "base_local_planner/TrajectoryPlannerROS"):
+        merged = {"controller_frequency": controller_frequency, **values}
+        if plugin == "dwa_local_planner/DWAPlannerROS":
+            dp, warnings = DWAParams.from_ros(merged)
+        else:
+            dp, warnings = DWAParams.from_trajectory_planner_ros(merged)
+        limits = LocalPlannerLimits(
+            acc_lim_th=dp.acc_lim_theta,
+            max_rotational_vel=dp.max_vel_theta,
+            min_in_place_rotational_vel=dp.min_vel_theta,
+            yaw_goal_tolerance=dp.yaw_goal_tolerance,
+        )
+        return DWAPlanner(dp, footprint=footprint), limits, warnings
+    if plugin == "teb_local_planner/TebLocalPlannerROS":
+        tp, warnings = TebParams.from_ros(values)
+        limits = LocalPlannerLimits(
+            acc_lim_th=tp.acc_lim_theta,
+            max_rotational_vel=tp.max_vel_theta,
+            min_in_place_rotational_vel=min(0.4, tp.max_vel_theta),
+            yaw_goal_tolerance=tp.yaw_goal_tolerance,
+        )
+        return TebPlanner(tp, footprint=footprint), limits, warnings
+    raise NavigationParamsError(f"move_base: unknown base_local_planner {plugin!r}")
+
+
+Recovery = ClearCostmapRecovery | RotateRecovery
+
+
+def make_recovery(
+    name: str,
+    plugin: str,
+    values: Mapping[str, Any],
+    *,
+    default_reset_distance: float,
+    limits: LocalPlannerLimits,
+    trajectory_planner: Mapping[str, Any],
+    footprint: ArrayLike,
+) -> Recovery:
+    """One recovery behaviour.
+
+    ``clear_costmap_recovery/ClearCostmapRecovery``: ``reset_distance`` defaults to
+    ``default_reset_distance`` (move_base: ``conservative_reset_dist``, or four times the
+    circumscribed radius for its ``aggressive_reset``).
+    ``rotate_recovery/RotateRecovery``: its own ``sim_granularity`` and ``frequency``; the
+    rotation limits from ``~TrajectoryPlannerROS/`` as ROS 1 reads them, else from the
+    local planner in use (ROS falls back to fixed defaults there).
+    """
+    if plugin == "clear_costmap_recovery/ClearCostmapRecovery":
+        return ClearCostmapRecovery.from_ros(
+            name, values, default_reset_distance=default_reset_distance
+        )
+    if plugin == "rotate_recovery/RotateRecovery":
+        unknown = sorted(set(values) - {"sim_granularity", "frequency"})
+        if unknown:
+            raise NavigationParamsError(f"{name}: unknown parameter(s) {', '.join(unknown)}")
+        tp = trajectory_planner
+        get: Callable[[str, float], float] = lambda key, fallback: float(  # noqa: E731
+            tp.get(key, fallback)
+        )
+        try:
+            params = RotateRecoveryParams(
+                sim_granularity=float(values.get("sim_granularity", 0.017)),
+                frequency=float(values.get("frequency", 20.0)),
+                acc_lim_th=get("acc_lim_th", limits.acc_lim_th),
+                max_rotational_vel=get("max_rotational_vel", limits.max_rotational_vel),
+                min_in_place_rotational_vel=get(
+                    "min_in_place_rotational_vel", limits.min_in_place_rotational_vel
+                ),
+                tolerance=get("yaw_goal_tolerance", limits.yaw_goal_tolerance),
+            )
+        except (TypeError, ValueError) as err:
+            raise NavigationParamsError(f"{name}: {err}") from None
+        return RotateRecovery(name, params, footprint=footprint)
+    raise NavigationParamsError(f"move_base: unknown recovery behavior type {plugin!r}")

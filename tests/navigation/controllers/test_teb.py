@@ -1,0 +1,152 @@
+"""teb_local_planner: band, robot models, optimisation in a closed loop, parameters."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from roverlab.geometry import SE2
+from roverlab.navigation.controllers import FootprintModel, TebParams, TebPlanner, Velocity2D
+from roverlab.navigation.controllers.teb import TimedElasticBand
+from roverlab.navigation.controllers.teb.kernels import robot_distance
+from roverlab.navigation.costmap import Costmap2D, footprint_from_radius
+from roverlab.navigation.errors import NavigationParamsError, NoValidControlError
+from roverlab.navigation.planners import NavfnPlanner
+from tests.navigation.controllers.conftest import TEB
+from tests.navigation.controllers.sim import ROBOT_RADIUS, costmaps, field_world, run
+
+FOOT = footprint_from_radius(ROBOT_RADIUS)
+
+
+def test_band_initialisation_and_autosize() -> None:
+    band = TimedElasticBand()
+    plan = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]])
+    band.init_from_plan(plan, 0.5, 1.0, True, 3, False)
+    assert band.poses.shape == (3, 3) and band.dts == pytest.approx([2.0, 2.0])
+    band.auto_resize(0.3, 0.1, 3, 500)  # one pass halves each long interval
+    assert len(band.dts) == len(band.poses) - 1 > 3
+    assert band.dts.sum() == pytest.approx(4.0)
+    assert band.poses[0] == pytest.approx(plan[0]) and band.poses[-1] == pytest.approx(plan[-1])
+    for _ in range(10):
+        band.auto_resize(0.3, 0.1, 3, 500)
+    assert (band.dts <= 0.4 + 1e-9).all()
+    band.update_and_prune(np.array([0.3, 0.0, 0.0]), np.array([2.0, 0.1, 0.0]), 3)
+    assert band.poses[0] == pytest.approx([0.3, 0.0, 0.0]) and band.poses[-1][1] == 0.1
+
+
+def test_robot_models_distances() -> None:
+    assert robot_distance(0, 0, 0, 0, np.zeros(0), 3.0, 4.0) == pytest.approx(5.0)
+    assert robot_distance(0, 0, 0, 1, np.array([1.0]), 3.0, 4.0) == pytest.approx(4.0)
+    two = np.array([0.5, 0.2, 0.5, 0.3])  # front 0.5 m ahead r 0.2, rear 0.5 m behind r 0.3
+    assert robot_distance(0, 0, math.pi / 2, 2, two, 0.0, 2.0) == pytest.approx(1.3)
+    line = np.array([-0.5, 0.0, 0.5, 0.0])
+    assert robot_distance(1, 1, 0, 3, line, 1.2, 2.0) == pytest.approx(1.0)
+    square = np.array([0.2, 0.2, -0.2, 0.2, -0.2, -0.2, 0.2, -0.2])
+    assert robot_distance(0, 0, 0, 4, square, 1.0, 0.0) == pytest.approx(0.8)
+
+
+def test_footprint_model_parameters() -> None:
+    m = FootprintModel.from_ros(
+        {"type": "polygon", "vertices": [[0.1, 0.1], [-0.1, 0.1], [0, -0.1]]}
+    )
+    assert m.code == 4 and len(m.values) == 6
+    p, _ = TebParams.from_ros(
+        {
+            "footprint_model/type": "line",
+            "footprint_model/line_start": [-0.1, 0.0],
+            "footprint_model/line_end": [0.1, 0.0],
+        }
+    )
+    assert p.footprint_model == FootprintModel("line", (-0.1, 0.0, 0.1, 0.0))
+    with pytest.raises(NavigationParamsError, match="radius is required"):
+        FootprintModel.from_ros({"type": "circular"})
+    with pytest.raises(NavigationParamsError, match="type must be one of"):
+        FootprintModel.from_ros({"type": "blob"})
+
+
+def test_parameters_validation_and_unimplemented_names() -> None:
+    p, warnings = TebParams.from_ros(
+        {**TEB, "enable_homotopy_class_planning": True, "max_vel_x_backwards": 0.0}
+    )
+    assert any("enable_homotopy_class_planning is not implemented" in w for w in warnings)
+    assert any("max_vel_x_backwards to be <= 0" in w for w in warnings)
+    with pytest.raises(NavigationParamsError, match="max_vel_y must be 0"):
+        TebParams.from_ros({"max_vel_y": 0.2})
+    with pytest.raises(NavigationParamsError, match="unknown parameter 'dt_reff'"):
+        TebParams.from_ros({"dt_reff": 0.3})
+    with pytest.raises(NavigationParamsError, match="dt_hysteresis"):
+        TebParams(dt_ref=0.3, dt_hysteresis=0.4)
+    assert p.trans_limit == p.max_vel_x
+
+
+def _open() -> Costmap2D:
+    return Costmap2D(size_x=60, size_y=60, resolution=0.05)
+
+
+def test_straight_run_command_respects_limits(teb_params: TebParams) -> None:
+    teb = TebPlanner(teb_params, footprint=FOOT)
+    plan = np.column_stack([np.linspace(0.5, 2.5, 21), np.full(21, 1.5), np.zeros(21)])
+    cmd = teb.compute_velocity(SE2(0.5, 1.5, 0.0), Velocity2D(), plan, _open())
+    assert 0.0 < cmd.vx <= teb_params.max_vel_x + 1e-9
+    assert abs(cmd.wz) < 0.2 and cmd.vy == 0.0
+    dts = teb.band.dts
+    assert (dts > 0).all() and len(teb.band.poses) >= teb_params.min_samples
+    # time-optimal against soft speed limits (TEB's penalties start at max - epsilon, and
+    # trade against time, so the band may plan a little above max_vel_x; the command is
+    # saturated)
+    mean_speed = float(np.sum(np.hypot(*np.diff(teb.band.poses[:, :2], axis=0).T))) / dts.sum()
+    assert 0.5 * 0.26 < mean_speed < 1.5 * 0.26
+
+
+def test_goal_reached_gives_a_zero_command(teb_params: TebParams) -> None:
+    teb = TebPlanner(teb_params, footprint=FOOT)
+    plan = np.array([[0.5, 1.5, 0.0], [1.5, 1.5, 0.5]])
+    cmd = teb.compute_velocity(SE2(1.48, 1.5, 0.45), Velocity2D(), plan, _open())
+    assert cmd == Velocity2D() and teb.is_goal_reached()
+    cmd = teb.compute_velocity(SE2(1.48, 1.5, 0.45), Velocity2D(0.2, 0, 0), plan, _open())
+    assert not teb.is_goal_reached()  # not stopped
+
+
+def test_blocked_start_is_not_feasible(teb_params: TebParams) -> None:
+    cm = _open()
+    cm.costs[26:35, 26:35] = 254  # the robot's outline over lethal cells
+    teb = TebPlanner(teb_params, footprint=FOOT)
+    plan = np.column_stack([np.linspace(1.5, 2.5, 11), np.full(11, 1.5), np.zeros(11)])
+    with pytest.raises(NoValidControlError, match="not feasible"):
+        for _ in range(3):
+            teb.compute_velocity(SE2(1.5, 1.5, 0.0), Velocity2D(), plan, cm)
+    assert not teb.band.is_init  # cleared, as TEB resets its planner
+
+
+@pytest.mark.parametrize("seed", [0, 2])
+def test_teb_reaches_the_goal_through_a_cluttered_field(teb_params: TebParams, seed: int) -> None:
+    r = run(
+        TebPlanner(teb_params, footprint=FOOT), field_world(seed), SE2(1, 1, 0), SE2(5, 5, 1.57)
+    )
+    assert r.reached and not r.collided, (r.pose, r.steps, r.failures)
+    assert math.hypot(r.pose.x - 5, r.pose.y - 5) < 0.1
+
+
+def test_move_forward_only(teb_params: TebParams) -> None:
+    p = TebParams.from_ros(
+        {**TEB, "max_vel_x_backwards": 0.01, "weight_kinematics_forward_drive": 1000}
+    )[0]
+    r = run(TebPlanner(p, footprint=FOOT), field_world(1), SE2(1, 1, math.pi), SE2(2.5, 1.5, 0.0))
+    assert r.reached and not r.collided
+    assert min(c.vx for c in r.commands) >= -0.01 - 1e-9
+
+
+def test_teb_is_deterministic(teb_params: TebParams) -> None:
+    glob, local = costmaps(field_world(3))
+    plan = NavfnPlanner().plan(SE2(1, 1, 0), SE2(5, 5, 0), glob.costmap)
+    local.update_map(1.0, 1.0, 0.0)
+    cmds = []
+    for _ in range(3):
+        teb = TebPlanner(teb_params, footprint=FOOT)
+        cmds.append(teb.compute_velocity(SE2(1, 1, 0), Velocity2D(0.1, 0, 0), plan, local.costmap))
+    # the same up to rounding: LAPACK's kernels inside MINPACK's QR may round the last bits
+    # differently from one call to the next
+    for c in cmds[1:]:
+        assert (c.vx, c.wz) == pytest.approx((cmds[0].vx, cmds[0].wz), abs=1e-8)
