@@ -12,7 +12,7 @@ import pytest
 
 from roverlab.core import Context
 from roverlab.description import find_package
-from roverlab.launch import REGISTRY, build_launch, load_launch
+from roverlab.launch import build_launch, load_launch
 from roverlab.msgs import Twist, get_factory
 from roverlab.msgs import classes as mc
 from roverlab.world import BUNDLED_WORLDS_DIR
@@ -70,12 +70,11 @@ def test_seed_002_launch_on_emulated_devices(
             "rplidarNode",
             "base_link_base_laser_link_broadcaster",
             "slam_gmapping",
+            "move_base",
             "usb_cam",
             "face_detector",
             "rviz",
         } <= names
-        if ("move_base", "move_base") not in REGISTRY:  # lands with the navigation issue
-            assert any("move_base/move_base is not part of roverlab" in w for w in launch.warnings)
         probe = ctx.create_node("probe")
         got: dict[str, list[object]] = {k: [] for k in ("scan", "odom", "map", "faces")}
         probe.create_subscription(mc.LaserScan, "/scan", got["scan"].append, 100)

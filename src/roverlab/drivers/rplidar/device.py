@@ -7,6 +7,7 @@ failure is a :class:`~roverlab.drivers.errors.DeviceError` naming the port.
 from __future__ import annotations
 
 import contextlib
+import os
 import struct
 import time
 from typing import Final
@@ -67,7 +68,8 @@ class RplidarDevice:
         try:
             self._serial = serial.Serial(self.port, self.baudrate, timeout=0.05)
         except (serial.SerialException, OSError, ValueError) as err:
-            reason = getattr(err, "strerror", None) or str(err)
+            code = getattr(err, "errno", None)
+            reason = os.strerror(code) if isinstance(code, int) else str(err)
             raise DeviceError(f"{self.port}: cannot open the serial port: {reason}") from err
 
     def close(self) -> None:

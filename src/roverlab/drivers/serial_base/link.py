@@ -8,6 +8,7 @@ what the command returns (garbage on the line).
 from __future__ import annotations
 
 import contextlib
+import os
 import time
 from typing import Final
 
@@ -46,7 +47,8 @@ class ArduinoLink:
         try:
             self._serial = serial.Serial(self.port, self.baudrate, timeout=0.02)
         except (serial.SerialException, OSError, ValueError) as err:
-            reason = getattr(err, "strerror", None) or str(err)
+            code = getattr(err, "errno", None)
+            reason = os.strerror(code) if isinstance(code, int) else str(err)
             raise DeviceError(f"{self.port}: cannot open the serial port: {reason}") from err
         deadline = time.monotonic() + boot_wait_s
         while True:
