@@ -64,8 +64,20 @@ def test_controller_ramp_and_timeout() -> None:
         BaseParams(wheel_diameter=0.1, wheel_track=0.0, encoder_resolution=10)
 
 
-def run_base(port: str, **extra: object) -> tuple[Context, ArduinoBaseNode, list[mc.Odometry]]:
+@pytest.fixture
+def contexts() -> Iterator[list[Context]]:
+    """Contexts shut down after the test, passed or not (their poll threads stop)."""
+    made: list[Context] = []
+    yield made
+    for ctx in made:
+        ctx.shutdown()
+
+
+def run_base(
+    contexts: list[Context], port: str, **extra: object
+) -> tuple[Context, ArduinoBaseNode, list[mc.Odometry]]:
     ctx = Context(clock="wall")
+    contexts.append(ctx)
     node = ArduinoBaseNode(
         ctx, boot_wait_s=0.5, parameter_overrides={"port": port, **BASE, **extra}
     )
@@ -85,8 +97,10 @@ def drive(ctx: Context, twist: Twist, seconds: float) -> None:
         t += 0.1
 
 
-def test_odometry_from_ticks_within_one_percent(board: ArduinoBaseEmulator) -> None:
-    ctx, _node, odoms = run_base(board.port)
+def test_odometry_from_ticks_within_one_percent(
+    board: ArduinoBaseEmulator, contexts: list[Context]
+) -> None:
+    ctx, _node, odoms = run_base(contexts, board.port)
     ctx.spin_for(0.5)
     drive(ctx, Twist(linear_x=0.3), 3.0)
     drive(ctx, Twist(angular_z=1.0), 2.0)
@@ -117,17 +131,21 @@ def test_odometry_from_ticks_within_one_percent(board: ArduinoBaseEmulator) -> N
 
 
 def test_board_goes_silent_then_answers(
-    board: ArduinoBaseEmulator, caplog: pytest.LogCaptureFixture
+    board: ArduinoBaseEmulator, caplog: pytest.LogCaptureFixture, contexts: list[Context]
 ) -> None:
     caplog.set_level(logging.INFO, logger="roverlab")
-    ctx, _node, odoms = run_base(board.port)
+    ctx, _node, odoms = run_base(contexts, board.port)
     drive(ctx, Twist(linear_x=0.2), 1.0)
     board.silent = True
     ctx.spin_for(3.0)
     frozen = len(odoms)
     ctx.spin_for(1.0)
     assert len(odoms) == frozen
-    errors = [r.getMessage() for r in caplog.records if r.levelname == "ERROR"]
+    errors = [
+        r.getMessage()
+        for r in caplog.records
+        if r.levelname == "ERROR" and r.getMessage().startswith(f"{board.port}:")
+    ]
     assert errors[0] == (
         f"{board.port}: the board stopped answering (nothing for 1 s); retrying every 1 s"
     )
@@ -141,9 +159,9 @@ def test_board_goes_silent_then_answers(
     ctx.shutdown()
 
 
-def test_garbage_answers_are_skipped(board: ArduinoBaseEmulator) -> None:
+def test_garbage_answers_are_skipped(board: ArduinoBaseEmulator, contexts: list[Context]) -> None:
     board.garbage_every = 4
-    ctx, node, odoms = run_base(board.port)
+    ctx, node, odoms = run_base(contexts, board.port)
     drive(ctx, Twist(linear_x=0.3), 3.0)
     ctx.spin_for(1.5)
     assert node.bad_answers > 5 and board.garbage_sent > 0
@@ -155,11 +173,18 @@ def test_garbage_answers_are_skipped(board: ArduinoBaseEmulator) -> None:
 
 
 def test_missing_port_and_roborts_base_mapping(
-    tmp_path: Path, caplog: pytest.LogCaptureFixture, board: ArduinoBaseEmulator
+    tmp_path: Path,
+    caplog: pytest.LogCaptureFixture,
+    board: ArduinoBaseEmulator,
+    contexts: list[Context],
 ) -> None:
-    ctx, _node, _odoms = run_base("/dev/ttyACM_roverlab_none")
+    ctx, _node, _odoms = run_base(contexts, "/dev/ttyACM_roverlab_none")
     ctx.spin_for(2.5)
-    errors = [r.getMessage() for r in caplog.records if r.levelname == "ERROR"]
+    errors = [
+        r.getMessage()
+        for r in caplog.records
+        if r.levelname == "ERROR" and "roverlab_none" in r.getMessage()
+    ]
     assert len(errors) == 1 and "cannot open the serial port" in errors[0]
     ctx.shutdown()
     yaml_file = tmp_path / "roborts_base_parameter.yaml"
@@ -175,6 +200,7 @@ def test_missing_port_and_roborts_base_mapping(
 </launch>"""
     )
     ctx = Context(clock="wall")
+    contexts.append(ctx)
     launch = build_launch(load_launch(launch_file), context=ctx)
     assert launch.warnings == [] and launch.nodes[0].get_name() == "roborts_base_node"
     odoms2: list[mc.Odometry] = []

@@ -146,10 +146,14 @@ def test_seed_004_car_drives_in_the_dashboard(daemon: str, browser: Any, tmp_pat
         page.wait_for_timeout(500)
         first = _robot_centre(page)
         page.locator("#view").screenshot(path=str(tmp_path / "car_t0.png"))
-        page.wait_for_timeout(3000)
-        second = _robot_centre(page)
+        moved, second = 0.0, first
+        for _ in range(60):  # about 3 s at 0.2 m/s; more on a loaded machine
+            page.wait_for_timeout(250)
+            second = _robot_centre(page)
+            moved = float(np.hypot(second[0] - first[0], second[1] - first[1]))
+            if moved > 0.3:
+                break
         shot = page.screenshot(path=str(tmp_path / "car_t3.png"))
-        moved = float(np.hypot(second[0] - first[0], second[1] - first[1]))
         assert moved > 0.3, (first, second)
         # a circle of radius v / w = 0.195 / 0.45 = 0.43 m around (0, 0.43)
         for cx, cy in (first, second):

@@ -8,7 +8,8 @@ the angle-compensation grid; the motor turns as the device does), ``channel_type
 (``serial``; ``tcp`` / ``udp`` are not implemented).
 
 Publishes ``scan`` (sensor_msgs/LaserScan, see :mod:`roverlab.drivers.rplidar.scan`) once
-per revolution, stamped with the time the revolution's first bytes arrived; services
+per revolution; ``scan_time`` is the revolution's nodes times the device's sample period
+(GET_SAMPLERATE) and the stamp that long before the revolution was complete; services
 ``stop_motor`` and ``start_motor`` (std_srvs/Empty).
 
 A reader thread talks to the device: STOP, GET_INFO, GET_HEALTH (an Error status is
@@ -153,18 +154,12 @@ class RplidarNode(Node):
     def _stream(self, device: RplidarDevice) -> None:
         decoder = NodeDecoder()
         revolutions = Revolutions()
-        rev_start_ns = 0
         reported = 0
         while self._motor.is_set() and not self._stop.is_set():
             data = device.read(SILENCE_S)
             now_ns = self.get_clock().now_ns()
-            nodes = decoder.feed(data)
-            for rev in revolutions.push(nodes):
-                if rev_start_ns:
-                    self._hand_over(rev, rev_start_ns, now_ns)
-                rev_start_ns = now_ns
-            if rev_start_ns == 0 and len(nodes):
-                rev_start_ns = now_ns
+            for rev in revolutions.push(decoder.feed(data)):
+                self._hand_over(rev, now_ns)
             self.dropped_bytes += decoder.dropped_bytes - reported
             if decoder.dropped_bytes and not reported:
                 self.get_logger().warning(
@@ -172,7 +167,10 @@ class RplidarNode(Node):
                 )
             reported = decoder.dropped_bytes
 
-    def _hand_over(self, rev: Any, start_ns: int, end_ns: int) -> None:
+    def _hand_over(self, rev: Any, end_ns: int) -> None:
+        """Publish a revolution completed at ``end_ns``: it took its nodes times the
+        device's sample period (the device's clock, not the host's reads, which come in
+        bursts), so it started that long before."""
         scan = build_scan(
             rev,
             angle_compensate=self.angle_compensate,
@@ -182,7 +180,8 @@ class RplidarNode(Node):
             max_distance_m=_MAX_DISTANCE_M,
         )
         if scan is not None:
-            duration = (end_ns - start_ns) / 1e9
+            duration = len(rev) * self.us_per_sample * 1e-6
+            start_ns = end_ns - int(duration * 1e9)
             self.context.executor.call_soon_threadsafe(
                 lambda: self._publish(scan, start_ns, duration)
             )
