@@ -16,6 +16,7 @@ import typer
 from roverlab.core import Context
 from roverlab.core.errors import TransportError
 from roverlab.core.transport.daemon import ensure_daemon
+from roverlab.core.transport.interfaces import split_wildcard_listen
 from roverlab.core.transport.zenoh import (
     GraphEntity,
     ZenohOptions,
@@ -95,7 +96,17 @@ class NetworkOptions:
             connect_timeout_s=_CONNECT_TIMEOUT_S if self.connect else None,
         )
         if not opts.connect and not self.multicast:
-            opts = replace(opts, connect=(ensure_daemon(),))
+            daemon = ensure_daemon()
+            # A robot listening with a password still joins its own machine's daemon
+            # (which asks for none): it checks the password of sessions that come in and
+            # offers none itself. ``tcp/0.0.0.0:7447`` becomes one endpoint per address of
+            # the machine, leaving 127.0.0.1:7447 to the daemon.
+            opts = replace(
+                opts,
+                connect=(daemon,),
+                listen=split_wildcard_listen(opts.listen, daemon),
+                present_credentials=False,
+            )
         return opts
 
 
