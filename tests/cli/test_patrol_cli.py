@@ -50,7 +50,7 @@ def test_ctrl_c_stops_the_robot(nav_stack: Proc, daemon: str) -> None:
     try:
         p.wait_line(lambda line: "Going to:" in line, timeout=60)
         p.popen.send_signal(signal.SIGINT)
-        out, err = p.popen.communicate(timeout=30)
+        out, err = p.communicate(timeout=30)
     finally:
         if p.popen.poll() is None:
             p.popen.kill()

@@ -17,7 +17,7 @@ from roverlab.core import Context, configure_logging
 from roverlab.core.transport.zenoh import ZenohTransport
 from roverlab.description import find_package
 from roverlab.errors import RoverlabError
-from roverlab.viz.config import load_rviz
+from roverlab.viz.config import DisplayConfig, load_rviz
 from roverlab.viz.server import DashboardServer
 
 
@@ -77,6 +77,9 @@ def demo(
         context.add_transport(recorder)
         if dashboard:
             config = load_rviz(find_package("robot_navigation") / "rviz" / "navigation.rviz")
+            config.displays.append(  # explore_lite's frontiers while it explores
+                DisplayConfig(kind="marker_array", name="Frontiers", topic="/explore/frontiers")
+            )
             server = DashboardServer(context, "127.0.0.1", port, config=config, map_dir=out)
             server.start()
             typer.echo(f"dashboard: {server.url}  (open it in a browser)")

@@ -27,6 +27,7 @@ from typing import Any, Final
 
 import yaml
 
+from roverlab.errors import yaml_reason
 from roverlab.viz.errors import DashboardError
 
 __all__ = [
@@ -501,7 +502,7 @@ def parse_rviz(text: str, source: str = "<rviz>") -> DashboardConfig:
     try:
         data = yaml.safe_load(text)
     except yaml.YAMLError as err:
-        raise ConfigError(f"{source}: not a valid .rviz (YAML) file: {err}") from err
+        raise ConfigError(f"{source}: not a valid .rviz (YAML) file: {yaml_reason(err)}") from err
     manager = data.get("Visualization Manager") if isinstance(data, Mapping) else None
     if not isinstance(manager, Mapping):
         raise ConfigError(f"{source}: no 'Visualization Manager' section: not an .rviz file")
