@@ -254,6 +254,7 @@ def test_robot_and_laptop_over_a_veth_pair(namespaces: Namespaces, tmp_path: Pat
                 "30",
             ],
             laptop_env,
+            timeout=120,
         )
         assert odom.returncode == 0, odom.stderr
         twist = _yaml_doc(odom.stdout)["twist"]["twist"]["angular"]["z"]  # type: ignore[index]
