@@ -6,6 +6,7 @@ from __future__ import annotations
 import itertools
 import logging
 import math
+import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -104,7 +105,11 @@ def test_odometry_from_ticks_within_one_percent(
     ctx.spin_for(0.5)
     drive(ctx, Twist(linear_x=0.3), 3.0)
     drive(ctx, Twist(angular_z=1.0), 2.0)
-    ctx.spin_for(1.5)  # the timeout stops the wheels; the last counts come in
+    ctx.spin_for(1.5)  # the timeout stops the wheels
+    deadline = time.monotonic() + 15.0  # a loaded machine: later
+    while board.speed != (0, 0) and time.monotonic() < deadline:
+        ctx.spin_for(0.2)
+    ctx.spin_for(1.0)  # the counts after the stop come in
     assert board.commands[:3] == ["b", "u 20:12:0:50", "r"]
     assert any(c.startswith("m 95 95") for c in board.commands)
     left, right = math.floor(board.left), math.floor(board.right)
