@@ -83,6 +83,8 @@ def explore(
         raise AutonomyError(f"unknown --slam {slam!r} (one of {', '.join(SLAM_METHODS)})")
     if not (duration > 0 and math.isfinite(duration)):
         raise AutonomyError(f"--duration must be a positive number of seconds, got {duration}")
+    if out.exists() and not out.is_dir():
+        raise AutonomyError(f"--out {out}: not a folder")
     pace = parse_rate(rate)
     configure_logging()
     if episodes != 1 or workers != 1 or ray_address is not None:
