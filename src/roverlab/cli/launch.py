@@ -18,6 +18,14 @@ from roverlab.launch import LaunchError, LaunchSpec, build_launch, load_launch
 
 CLOCKS = ("auto", "sim", "external", "wall")
 _SIMULATOR_NODES = {("gazebo_ros", "gzserver"), ("gazebo_ros", "spawn_model")}
+_DEVICE_NODES = {
+    ("arbotix_python", "arbotix_driver"),
+    ("rplidar_ros", "rplidarNode"),
+    ("rplidar_ros", "rplidar_node"),
+    ("usb_cam", "usb_cam_node"),
+    ("ros_arduino_python", "arduino_node.py"),
+    ("roborts_base", "roborts_base_node"),
+}
 
 
 def choose_clock(spec: LaunchSpec, clock: str, pace: float) -> tuple[str, str]:
@@ -26,8 +34,9 @@ def choose_clock(spec: LaunchSpec, clock: str, pace: float) -> tuple[str, str]:
     ``auto``: a launch with a simulator (gzserver / spawn_model) runs it on its own clock
     (paced by ``--rate``); one without follows ``/clock`` from another process (a
     ``roverlab sim`` in another terminal: what ROS does with ``/use_sim_time`` true, which
-    a Gazebo launch sets for everybody), unless the file sets ``/use_sim_time`` false,
-    which means wall time.
+    a Gazebo launch sets for everybody), unless the file sets ``/use_sim_time`` false or
+    starts a driver node (arbotix, a lidar, a camera, a serial base: a real robot or
+    arbotix's fake one), which means wall time.
     """
     if clock not in CLOCKS:
         raise LaunchError(f"unknown --clock {clock!r} ({', '.join(CLOCKS)})")
@@ -40,6 +49,11 @@ def choose_clock(spec: LaunchSpec, clock: str, pace: float) -> tuple[str, str]:
         return own, ""
     if spec.params.get("/use_sim_time") is False:
         return "wall", "no simulator in this launch and /use_sim_time is false: wall time"
+    if any((n.pkg, n.type) in _DEVICE_NODES for n in spec.nodes):
+        return "wall", (
+            "driver nodes (arbotix, a lidar, a camera, a serial base) and no simulator in this "
+            "launch: wall time, as ROS without /use_sim_time"
+        )
     return "external", (
         "no simulator in this launch: following /clock from another process "
         "(start `roverlab sim` elsewhere, or pass --clock wall)"

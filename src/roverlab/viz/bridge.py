@@ -32,6 +32,7 @@ from roverlab.errors import RoverlabError
 from roverlab.geometry import Transform3, yaw_from_quat
 from roverlab.maps import save_map
 from roverlab.msgs import (
+    JointState,
     PointStamped,
     PoseStamped,
     PoseWithCovarianceStamped,
@@ -56,6 +57,7 @@ from roverlab.viz.displays import (
 )
 from roverlab.viz.errors import DashboardError
 from roverlab.viz.handlers import HANDLERS, DisplayState, Versioned, markers_changed
+from roverlab.viz.joints import SLIDER_TOPIC, JointSliders
 from roverlab.viz.protocol import (
     INITIALPOSE_COVARIANCE,
     VisualOutline,
@@ -162,6 +164,8 @@ class VizBridge:
         self._rate_samples: dict[str, deque[tuple[float, int]]] = {}
         self.outlines: Versioned | None = None
         self.shapes: list[dict[str, Any]] = []
+        self.joint_sliders: JointSliders | None = None
+        self._slider_pub: Any = None
         self._description_sub: Any = None
         self._description_topic = ""
         self.config = config if config is not None else default_config(fixed_frame)
@@ -327,6 +331,20 @@ class VizBridge:
         model = parse_urdf(str(msg.data), source=self._description_topic)
         self.shapes = [shape.to_dict() for shape in robot_shapes(model)]
         self.outlines = Versioned(self.next_version(), robot_outlines(model))
+        self.joint_sliders = JointSliders(model)
+
+    def set_joint(self, name: str, position: float) -> None:
+        """Move a joint slider and publish every slider on the sliders topic.
+
+        Raises:
+            KeyError: no robot description yet, or no such joint.
+        """
+        if self.joint_sliders is None:
+            raise KeyError("no robot description: no joints to move")
+        self.joint_sliders.set(name, position)
+        if self._slider_pub is None:
+            self._slider_pub = self.node.create_publisher(JointState, SLIDER_TOPIC, 10)
+        self._slider_pub.publish(self.joint_sliders.message(self.node.get_clock().now().to_msg()))
 
     # ---------------------------------------------------------------- queries
     def refresh_remote_graph(self) -> None:
@@ -465,6 +483,7 @@ class VizBridge:
             "robot": robot,
             "frames3": frames3,
             "robot3d": self.shapes,
+            "joints": self.joint_sliders.to_list() if self.joint_sliders else [],
             "displays": [d.info for d in self.displays],
             "status": self.status(frames, outlines),
             "image_topics": self.image_topics(),

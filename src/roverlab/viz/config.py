@@ -445,7 +445,7 @@ def _rviz_display(d: Mapping[str, Any], kind: str, where: str) -> DisplayConfig:
         num("Alpha", "alpha")
     if "Color" in d and "color" in DISPLAY_KINDS[kind].options:
         opts["color"] = _rviz_color(d["Color"], where)
-    topic = d.get("Topic")
+    topic = d.get("Topic", d.get("Image Topic"))  # rviz 1 Image/Camera: "Image Topic"
     if kind == "grid":
         num("Cell Size", "cell_size")
         num("Plane Cell Count", "cell_count", integer=True)

@@ -9,7 +9,8 @@ robot outline, status tree; the topic list with rates once a second) at
 :attr:`DashboardServer.state_rate_hz`.
 
 The page sends JSON back: tools ``{"type": "goal" | "initialpose", "x", "y", "yaw"}``,
-``{"type": "point", "x", "y"}``; drive ``{"type": "key", "key": "i"}``,
+``{"type": "point", "x", "y"}``; joint sliders ``{"type": "joint", "name", "position"}``;
+drive ``{"type": "key", "key": "i"}``,
 ``{"type": "speed", "speed", "turn"}``; ``{"type": "config", "config": {...}}`` (the
 whole configuration, :meth:`DashboardConfig.to_dict` form), ``{"type": "save_config"}``,
 ``{"type": "save_map", "name": "map"}`` and ``{"type": "image_topic", "topic"}``. Replies
@@ -239,6 +240,8 @@ class DashboardServer:
             bridge.drive_key(str(msg["key"])[:1])
         elif kind == "speed":
             bridge.set_speeds(_number(msg, "speed"), _number(msg, "turn"))
+        elif kind == "joint":
+            bridge.set_joint(str(msg["name"]), _number(msg, "position"))
         elif kind == "image_topic":
             bridge.select_image(str(msg["topic"]))
         elif kind == "config":

@@ -233,9 +233,33 @@
     updateStatus(msg.status);
     updateFrameSelects(msg);
     renderImageTopics(msg.image_topics || []);
+    renderJoints(msg.joints || []);
     const sp = $("speed"), tu = $("turn");
     if (document.activeElement !== sp) sp.value = msg.drive.speed.toFixed(3);
     if (document.activeElement !== tu) tu.value = msg.drive.turn.toFixed(3);
+  }
+
+  // joint_state_publisher_gui: one slider per movable joint of the robot description
+  function renderJoints(joints) {
+    const box = $("joints");
+    $("joints-panel").style.display = joints.length ? "" : "none";
+    const names = joints.map((j) => j.name).join(",");
+    if (box.dataset.names !== names) {
+      box.dataset.names = names; box.innerHTML = "";
+      for (const j of joints) {
+        const row = document.createElement("div"); row.className = "row";
+        const label = document.createElement("span"); label.textContent = j.name; label.style.width = "40%";
+        const inp = document.createElement("input"); inp.type = "range"; inp.className = "joint";
+        inp.min = j.lower; inp.max = j.upper; inp.step = (j.upper - j.lower) / 1000; inp.dataset.joint = j.name;
+        const val = document.createElement("span"); val.className = "joint-value";
+        inp.oninput = () => { val.textContent = Number(inp.value).toFixed(2); send({ type: "joint", name: j.name, position: Number(inp.value) }); };
+        row.append(label, inp, val); box.append(row);
+      }
+    }
+    for (const j of joints) {
+      const inp = box.querySelector(`input[data-joint="${CSS.escape(j.name)}"]`);
+      if (inp && document.activeElement !== inp) { inp.value = j.position; inp.nextSibling.textContent = j.position.toFixed(2); }
+    }
   }
 
   // -------------------------------------------------------------- side panel
