@@ -138,7 +138,10 @@ def test_seed_004_car_drives_in_the_dashboard(daemon: str, browser: Any, tmp_pat
             "() => { const c = structuredClone(viz.data.config);"
             " c.displays.at(-1).options.length = 0.12; viz.send({type: 'config', config: c}); }"
         )
+        # showmycar.rviz's view is rviz's Orbit (the 3D view); this test drives the 2D one
+        page.evaluate("() => viz.setViewMode('2D')")
         box = page.locator("#view").bounding_box()
+        assert box is not None
         page.mouse.move(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
         for _ in range(5):
             page.mouse.wheel(0, -300)
