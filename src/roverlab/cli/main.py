@@ -14,6 +14,7 @@ from roverlab.cli import (
     demo,
     graph,
     launch,
+    nav,
     run,
     service,
     sim,
@@ -59,6 +60,7 @@ slam_cli.app.command("mapeval")(slam_mapeval.mapeval)
 app.add_typer(slam_cli.app, name="slam")
 app.command("teleop")(teleop_cli.teleop)
 app.add_typer(amcl_run.app, name="amcl")
+app.add_typer(nav.app, name="nav")
 
 
 @app.callback()
