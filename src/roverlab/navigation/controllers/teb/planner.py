@@ -499,9 +499,10 @@ class TebPlanner:
             band.update_and_prune(start, goal, p.min_samples)
         else:
             band.clear()
+            spacing = (p.dt_ref - p.dt_hysteresis) * p.max_vel_x if p.teb_autosize else 0.0
             band.init_from_plan(
                 local, p.max_vel_x, p.max_vel_theta, p.global_plan_overwrite_orientation,
-                p.min_samples, p.allow_init_with_backwards_motion,
+                p.min_samples, p.allow_init_with_backwards_motion, max(spacing, 0.0),
             )  # fmt: skip
         try:
             self._optimize(twist, p.free_goal_vel)
