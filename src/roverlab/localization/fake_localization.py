@@ -12,6 +12,11 @@ becomes
 * ``amcl_pose`` (``PoseWithCovarianceStamped``, zero covariance) and ``particlecloud``
   (``PoseArray``: one pose), in ``global_frame_id``.
 
+``initialpose`` (rviz's 2D Pose Estimate) moves the offset so that the robot's current
+pose becomes the one given (``offset = pose * base_T_map * offset``, ``base_T_map`` from
+TF at the message's stamp); a pose in another frame than ``global_frame_id`` is used all
+the same, with a warning, as ROS does.
+
 Parameters (ROS names and defaults): ``odom_frame_id`` ("odom"), ``base_frame_id``
 ("base_link"), ``global_frame_id`` ("/map"), ``delta_x``, ``delta_y``, ``delta_yaw`` (0),
 ``transform_tolerance`` (0.1 s).
@@ -103,6 +108,26 @@ class FakeLocalization(Node):
             self, self.tf_buffer, [self.odom_frame], _QUEUE, self._update
         )
         self.create_subscription(mc.Odometry, "base_pose_ground_truth", self._on_truth, _QUEUE)
+        self.create_subscription(
+            mc.PoseWithCovarianceStamped, "initialpose", self._on_initialpose, 1
+        )
+
+    def _on_initialpose(self, msg: Any) -> None:
+        frame = str(msg.header.frame_id).lstrip("/")
+        if frame != self.global_frame:
+            self.get_logger().warning(
+                f'Frame ID of "initialpose" ({msg.header.frame_id}) is different from the '
+                f"global frame {self.global_frame}"
+            )
+        try:
+            base_in_map, _ = self.tf_buffer.lookup_transform(
+                self.base_frame, self.global_frame, Time.from_msg(msg.header.stamp)
+            )
+        except TransformException:
+            self.get_logger().warning("Failed to lookup transform!")
+            return
+        pose = SE2(*xytheta_from_pose(msg.pose.pose))
+        self._offset = pose * base_in_map.to_se2() * self._offset
 
     def _on_truth(self, msg: Any) -> None:
         self._filter.add(_Waiting(_Header(self.base_frame, msg.header.stamp), msg))

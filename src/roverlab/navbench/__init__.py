@@ -13,9 +13,11 @@ from roverlab.navbench.harness import (
     PARAM_SETS,
     PLANNERS,
     SUCCESS_RADIUS_M,
+    TIMING_KEYS,
     BenchConfig,
     BenchError,
     run_bench,
+    run_episode,
 )
 from roverlab.navbench.report import BenchReport, GoalRecord
 
@@ -24,6 +26,7 @@ __all__ = [
     "PARAM_SETS",
     "PLANNERS",
     "SUCCESS_RADIUS_M",
+    "TIMING_KEYS",
     "BenchConfig",
     "BenchError",
     "BenchGrid",
@@ -31,5 +34,6 @@ __all__ = [
     "GoalRecord",
     "GoalSamplingError",
     "run_bench",
+    "run_episode",
     "sample_goals",
 ]

@@ -11,6 +11,7 @@ map the world is rasterised at 0.05 m in the robot's height band and saved as
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import signal
 import time
@@ -45,9 +46,11 @@ __all__ = [
     "PARAM_SETS",
     "PLANNERS",
     "SUCCESS_RADIUS_M",
+    "TIMING_KEYS",
     "BenchConfig",
     "BenchError",
     "run_bench",
+    "run_episode",
 ]
 
 PLANNERS = ("dwa", "teb")
@@ -368,14 +371,30 @@ class _Bench:
         return st not in (GoalStatus.PENDING, GoalStatus.ACTIVE)
 
 
+#: summary keys that are measured compute times (or describe the machine): everything else
+#: in a run's results is a function of the configuration and the seed
+TIMING_KEYS = (
+    "planner_ms_p99",
+    "controller_ms_p99",
+    "planner_wall_ms_p99",
+    "controller_wall_ms_p99",
+    "wall_time_s",
+    "machine",
+)
+
+
 def run_bench(
     config: BenchConfig,
     *,
     log: Callable[[str], None] = lambda _line: None,
 ) -> BenchReport:
     """Run the benchmark; writes ``bench.json`` after every goal and ``bench.png`` at the
-    end (both replaced atomically). SIGINT, SIGTERM and SIGHUP end it after writing the
-    goals done so far (``report.interrupted`` names the signal).
+    end (both replaced atomically) into ``config.out``. SIGINT, SIGTERM and SIGHUP end it
+    after writing the goals done so far (``report.interrupted`` names the signal).
+
+    Everything but the :data:`TIMING_KEYS` is the same for the same configuration and
+    seed: the simulator, amcl and the goals draw from generators seeded by
+    ``config.seed`` and every node runs on the simulated clock.
 
     Raises:
         BenchError, WorldError, SimulationError, MapError, LaunchError, GoalSamplingError:
@@ -384,6 +403,7 @@ def run_bench(
     params_dir = config.validate()
     wall0 = time.perf_counter()
     stop = _Stop()
+    out = Path(config.out)
     with _signals(stop):
         bench = _Bench(config, params_dir, log)
         try:
@@ -399,6 +419,15 @@ def run_bench(
                 bench.grid, spawn, config.goals, np.random.default_rng(config.seed),
                 clearance=clearance,
             )  # fmt: skip
+
+            def totals() -> None:
+                report.set_totals(
+                    timings=bench.timings,
+                    collisions=bench.simulator.contacts,
+                    sim_time_s=bench.ctx.now().nanoseconds / 1e9,
+                    wall_time_s=time.perf_counter() - wall0,
+                )
+
             bench.ready(stop)
             for i, goal in enumerate(goals):
                 if stop.signum is not None:
@@ -407,24 +436,32 @@ def run_bench(
                 if rec is None:
                     break
                 report.add(rec)
-                report.set_totals(
-                    timings=bench.timings,
-                    collisions=bench.simulator.contacts,
-                    sim_time_s=bench.ctx.now().nanoseconds / 1e9,
-                    wall_time_s=time.perf_counter() - wall0,
-                )
-                report.write_json(Path(config.out) / "bench.json")
+                totals()
+                report.write_json(out / "bench.json")
                 log(rec.progress_line(len(goals)))
             if stop.signum is not None:
                 report.interrupted = signal.Signals(stop.signum).name
-            report.set_totals(
-                timings=bench.timings,
-                collisions=bench.simulator.contacts,
-                sim_time_s=bench.ctx.now().nanoseconds / 1e9,
-                wall_time_s=time.perf_counter() - wall0,
-            )
-            report.write_json(Path(config.out) / "bench.json")
-            report.write_png(Path(config.out) / "bench.png")
+            totals()
+            report.write_json(out / "bench.json")
+            report.write_png(out / "bench.png")
         finally:
             bench.ctx.shutdown()
     return report
+
+
+def run_episode(
+    config: BenchConfig,
+    seed: int,
+    *,
+    log: Callable[[str], None] = lambda _line: None,
+) -> dict[str, Any]:
+    """One episode of a multi-episode benchmark: :func:`run_bench` with ``config``'s seed
+    replaced by ``seed``, writing into ``config.out / f"seed-{seed:04d}"``; returns what
+    ``bench.json`` holds (the summary and one record per goal).
+
+    A plain function of picklable arguments, one context per call (a worker process can
+    run it as a task); the result is the same for the same ``config`` and ``seed`` but for
+    the :data:`TIMING_KEYS`.
+    """
+    cfg = dataclasses.replace(config, seed=seed, out=Path(config.out) / f"seed-{seed:04d}")
+    return run_bench(cfg, log=log).to_dict()

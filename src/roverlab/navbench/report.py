@@ -222,9 +222,12 @@ class BenchReport:
         return line
 
     # ------------------------------------------------------------------ files
+    def to_dict(self) -> dict[str, Any]:
+        """What ``bench.json`` holds: :meth:`summary` and ``records``, one per goal."""
+        return {**self.summary(), "records": [r.to_json() for r in self.records]}
+
     def write_json(self, path: Path) -> None:
-        data = {**self.summary(), "records": [r.to_json() for r in self.records]}
-        _atomic_write(path, (json.dumps(data, indent=1) + "\n").encode())
+        _atomic_write(path, (json.dumps(self.to_dict(), indent=1) + "\n").encode())
 
     def write_png(self, path: Path) -> None:
         img = draw(self.grid, self.records)
