@@ -16,7 +16,7 @@ install: $(VENV)/.installed
 
 ## Install, then run the main job on the built-in default world and robot.
 run: install
-	$(VENV)/bin/roverlab sim
+	$(VENV)/bin/roverlab demo
 
 lint: install
 	$(VENV)/bin/ruff check src tests benchmarks

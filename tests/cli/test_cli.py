@@ -9,6 +9,8 @@ from typing import Any
 import pytest
 import yaml
 
+from roverlab.description import load_robot
+from roverlab.sim.app import resolve_robot
 from tests.helpers.procs import Proc
 
 pytestmark = pytest.mark.zenoh
@@ -121,21 +123,23 @@ def test_info_unknown_topic_exit_2(cli: Any) -> None:
     assert r.returncode == 2 and "unknown topic '/nothing_here'" in r.stderr
 
 
-def test_tf_echo_and_frames_against_demo(daemon: str, cli: Any) -> None:
-    demo = Proc([sys.executable, "-m", "roverlab.cli", "demo", "--duration", "60"])
+def test_tf_echo_and_frames_against_the_simulator(daemon: str, cli: Any) -> None:
+    sim = Proc([sys.executable, "-m", "roverlab.cli", "sim", "--duration", "60"])
     try:
-        r = cli("tf", "echo", "odom", "laser", "--count", "1", "--timeout", "15")
+        r = cli("tf", "echo", "odom", "base_laser_link", "--count", "1", "--timeout", "15")
         assert r.returncode == 0, r.stderr
         assert "- Translation: [" in r.stdout and "- Rotation: in Quaternion" in r.stdout
-        # laser is 0.15 m above the footprint (0.05 + 0.10): z of the translation
+        # the lidar's height on mybot, from its URDF
+        links = load_robot(resolve_robot("mybot")).link_transforms()
+        z = (~links["base_footprint"] * links["base_laser_link"]).translation[2]
         translation = r.stdout.split("- Translation: [")[1].split("]")[0]
-        assert abs(float(translation.split(",")[2]) - 0.15) < 1e-6
+        assert abs(float(translation.split(",")[2]) - z) < 1e-3
         r = cli("tf", "frames", "--wait", "2")
         assert r.returncode == 0, r.stderr
-        for frame in ("odom", "base_footprint", "base_link", "laser"):
+        for frame in ("odom", "base_footprint", "base_link", "base_laser_link"):
             assert frame in r.stdout
     finally:
-        demo.stop()
+        sim.stop()
 
 
 def test_help_is_complete() -> None:

@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 import os
-import selectors
+import queue
 import subprocess
+import threading
 import time
 from collections.abc import Callable
 
@@ -12,7 +13,11 @@ __all__ = ["Proc"]
 
 
 class Proc:
-    """A child process whose stdout lines are read with a timeout."""
+    """A child process whose stdout lines are read with a timeout.
+
+    A thread reads stdout line by line into a queue (a selector on the pipe misses lines
+    that a buffered read already took in when several arrive at once).
+    """
 
     def __init__(self, args: list[str]) -> None:
         self.popen = subprocess.Popen(
@@ -22,26 +27,70 @@ class Proc:
             text=True,
             env={**os.environ, "PYTHONUNBUFFERED": "1"},
         )
+        self._lines: queue.Queue[str | None] = queue.Queue()
+        self._reader = threading.Thread(target=self._read, daemon=True)
+        self._reader.start()
+        self._err: list[str] = []
+        self._err_reader = threading.Thread(target=self._read_err, daemon=True)
+        self._err_reader.start()
+
+    def _read(self) -> None:
+        assert self.popen.stdout is not None
+        for line in self.popen.stdout:
+            self._lines.put(line)
+        self._lines.put(None)  # end of output
+
+    def _read_err(self) -> None:
+        assert self.popen.stderr is not None
+        for line in self.popen.stderr:
+            self._err.append(line)
+
+    def stderr(self, timeout: float = 5.0) -> str:
+        """All of stderr so far (up to its end if the process has ended)."""
+        if self.popen.poll() is not None:
+            self._err_reader.join(timeout)
+        return "".join(self._err)
 
     def wait_line(
         self, predicate: Callable[[str], bool] | None = None, timeout: float = 15.0
     ) -> str:
-        sel = selectors.DefaultSelector()
-        assert self.popen.stdout is not None
-        sel.register(self.popen.stdout, selectors.EVENT_READ)
+        """The next stdout line (without its newline) for which ``predicate`` holds;
+        lines before it are consumed."""
         deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
-            if not sel.select(timeout=max(0.0, deadline - time.monotonic())):
+        while True:
+            try:
+                line = self._lines.get(timeout=max(0.0, deadline - time.monotonic()))
+            except queue.Empty:
                 break
-            line = self.popen.stdout.readline()
-            if not line:
+            if line is None:
+                self._lines.put(None)
                 break
             if predicate is None or predicate(line):
                 return line.rstrip("\n")
-        err = (
-            self.popen.stderr.read() if self.popen.poll() is not None and self.popen.stderr else ""
-        )
+        err = self.stderr()
         raise AssertionError(f"no expected line within {timeout} s; stderr: {err}")
+
+    def rest(self, timeout: float = 10.0) -> str:
+        """The stdout not consumed yet, up to the end of the process's output."""
+        self._reader.join(timeout)
+        out: list[str] = []
+        while True:
+            try:
+                line = self._lines.get_nowait()
+            except queue.Empty:
+                break
+            if line is None:
+                self._lines.put(None)
+                break
+            out.append(line)
+        return "".join(out)
+
+    def communicate(self, timeout: float) -> tuple[str, str]:
+        """Wait for the process to end; the stdout not consumed yet and all of stderr
+        (``Popen.communicate`` would race the reader thread for stdout)."""
+        self.popen.wait(timeout=timeout)
+        err = self.stderr()
+        return self.rest(), err
 
     def stop(self) -> str:
         if self.popen.poll() is None:
@@ -50,4 +99,4 @@ class Proc:
                 self.popen.wait(timeout=5)
             except subprocess.TimeoutExpired:
                 self.popen.kill()
-        return self.popen.stderr.read() if self.popen.stderr else ""
+        return self.stderr()

@@ -82,10 +82,10 @@ def _slam(until: Callable[[list[str]], bool], timeout: float = 60.0) -> tuple[li
             messages.append(m.group(1))
         proc.popen.send_signal(signal.SIGINT)
         try:
-            out, err = proc.popen.communicate(timeout=30)
+            out, err = proc.communicate(timeout=30)
         except subprocess.TimeoutExpired:
             proc.popen.send_signal(signal.SIGABRT)  # faulthandler prints every thread
-            out, err = proc.popen.communicate(timeout=10)
+            out, err = proc.communicate(timeout=10)
             raise AssertionError(f"slam.py did not stop on Ctrl-C: {err[-4000:]}") from None
     finally:
         if proc.popen.poll() is None:
@@ -116,7 +116,7 @@ def test_slam_py_patrols_and_reports(move_base: Any) -> None:
     assert "Stopping the robot..." in messages
     assert messages[-1] == "Exploring SLAM finished."
     server.stop()
-    out = server.popen.stdout.read().splitlines() if server.popen.stdout else []
+    out = server.rest().splitlines()
     # the goals reached the server in the map frame at the seed's coordinates, and the
     # shutdown hook's zero Twist reached /cmd_vel
     seed_places = {
@@ -149,7 +149,7 @@ def test_slam_py_times_out_a_goal_after_300_s(move_base: Any) -> None:
     assert code == 0, err
     assert "Timed out achieving goal" in messages
     server.stop()
-    out = server.popen.stdout.read() if server.popen.stdout else ""
+    out = server.rest()
     assert "preempt" in out.splitlines()  # slam.py canceled the goal it gave up on
 
 

@@ -103,7 +103,7 @@ class McapRecorder:
 
     # ------------------------------------------------------------- recording
     def _record(self, topic: str, typename: str) -> None:
-        if topic in self._channels or topic in self.exclude:
+        if self._fh is None or topic in self._channels or topic in self.exclude:
             return
         if self.only is not None and topic not in self.only:
             return

@@ -35,6 +35,7 @@ from roverlab.localization.amcl import (
     map_for_amcl,
 )
 from roverlab.maps import OccupancyMap, load_map, occupancy_to_image
+from roverlab.slam.reversing import ReversingRepair
 from roverlab.slam.trajectory import read_tum, write_tum
 
 __all__ = ["app", "run"]
@@ -153,6 +154,14 @@ def run(
     odom_frame: OdomFrameOption = "odom",
     base_frame: BaseFrameOption = None,
     first: FirstOption = None,
+    logged_odometry: Annotated[
+        bool,
+        typer.Option(
+            "--logged-odometry",
+            help="CARMEN logs: use the odometry poses as logged, without reversing the "
+            "steps that went forward while ODOM's velocity was negative.",
+        ),
+    ] = False,
 ) -> None:
     """Localise a recorded log on MAP: DIR/trajectory.tum (robot pose in the map at every
     scan) and DIR/amcl.png (map, trajectory, particle clouds)."""
@@ -172,6 +181,7 @@ def run(
     amcl = Amcl(params, amcl_map, rng=np.random.default_rng(seed), initial_pose=pose,
                 global_start=global_start)  # fmt: skip
     started = time.monotonic()
+    reversing = None if logged_odometry else ReversingRepair()
     records = read_log(
         log,
         scan_topic=scan_topic,
@@ -181,10 +191,18 @@ def run(
         base_frame=base_frame,
         first=first,
         error=AmclError,
+        reversing=reversing,
     )
     read_s = time.monotonic() - started
     n = len(records)
     typer.echo(f"{n} scans from {log}; start: {source}", err=True)
+    if reversing is not None and reversing.reversed_steps:
+        typer.echo(
+            f"odometry: {reversing.reversed_steps} of {reversing.steps} steps moved forward "
+            "while the velocity was negative (reversing); they were reversed "
+            "(--logged-odometry: as logged)",
+            err=True,
+        )
     snaps = sorted({-1, n // 3, (2 * n) // 3, n - 1})
     result = localize_log(progress(records, "amcl"), amcl, snapshot_at=snaps)
     wall = time.monotonic() - started

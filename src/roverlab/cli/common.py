@@ -2,14 +2,19 @@
 
 from __future__ import annotations
 
+import contextlib
 import math
+import signal
+import threading
 import time
+from collections.abc import Iterator
 from dataclasses import dataclass, replace
 from typing import Any
 
 import typer
 
 from roverlab.core import Context
+from roverlab.core.errors import TransportError
 from roverlab.core.transport.daemon import ensure_daemon
 from roverlab.core.transport.zenoh import (
     GraphEntity,
@@ -18,7 +23,19 @@ from roverlab.core.transport.zenoh import (
     query_graph,
 )
 
-__all__ = ["Connection", "NetworkOptions", "choose_expose", "network_options", "run_context"]
+__all__ = [
+    "FOLLOWER_CLOCKS",
+    "Connection",
+    "NetworkOptions",
+    "choose_expose",
+    "connect_following_clock",
+    "network_options",
+    "run_context",
+    "stop_on_signals",
+]
+
+#: ``--clock`` of commands that join a running system (``roverlab run``, ``patrol``).
+FOLLOWER_CLOCKS = ("auto", "wall", "external")
 
 _SETTLE_S = 0.3
 
@@ -87,6 +104,26 @@ def network_options(ctx: typer.Context) -> NetworkOptions:
     return obj if isinstance(obj, NetworkOptions) else NetworkOptions()
 
 
+@contextlib.contextmanager
+def stop_on_signals(stop: threading.Event) -> Iterator[threading.Event]:
+    """Inside the block SIGINT, SIGTERM and SIGHUP set ``stop`` (the command then finishes
+    its output files and returns) instead of killing the process; the old handlers come
+    back at the end. A second SIGINT interrupts (KeyboardInterrupt)."""
+
+    def on_signal(signum: int, _frame: Any) -> None:
+        if signum == signal.SIGINT and stop.is_set():
+            raise KeyboardInterrupt
+        stop.set()
+
+    sigs = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+    old = {s: signal.signal(s, on_signal) for s in sigs}
+    try:
+        yield stop
+    finally:
+        for s, handler in old.items():
+            signal.signal(s, handler)
+
+
 def run_context(context: Context, duration_s: float | None) -> float:
     """Spin until ``duration_s`` of clock time (or forever), Ctrl-C, or shutdown; then
     shut the context down. Returns the wall seconds it ran."""
@@ -117,3 +154,26 @@ def choose_expose(expose: bool | None, pace: float) -> bool:
         )
         return False
     return True
+
+
+def connect_following_clock(options: NetworkOptions, clock: str) -> tuple[ZenohTransport, str, str]:
+    """The transport, and the clock mode (``auto``: follow /clock when someone publishes
+    it, as a ROS node with /use_sim_time does next to a simulator; else wall time)."""
+    if clock not in FOLLOWER_CLOCKS:
+        raise TransportError(f"unknown --clock {clock!r} ({', '.join(FOLLOWER_CLOCKS)})")
+    transport = ZenohTransport(options.zenoh_options())
+    if clock != "auto":
+        return transport, clock, ""
+    time.sleep(0.3)  # the router's declarations reach a fresh session first
+    deadline = time.monotonic() + 1.0
+    while True:
+        clocks = [
+            e
+            for e in query_graph(transport.session, transport.domain, 0.5)
+            if e.kind == "publisher" and e.topic == "/clock"
+        ]
+        if clocks:
+            return transport, "external", f"following /clock from {clocks[0].node} (sim time)"
+        if time.monotonic() >= deadline:
+            return transport, "wall", ""
+        time.sleep(0.2)

@@ -21,6 +21,7 @@ from rich.progress import (
 
 from roverlab.errors import RoverlabError
 from roverlab.slam.logs import LaserLog, ScanRecord, load_log
+from roverlab.slam.reversing import ReversingRepair
 
 __all__ = [
     "BaseFrameOption",
@@ -114,8 +115,10 @@ def read_log(
     base_frame: str | None,
     first: int | None,
     error: Callable[[str], RoverlabError],
+    reversing: ReversingRepair | None = None,
 ) -> LaserLog:
-    """Load a CARMEN log or a bag (with the bag options), keeping the ``first`` scans.
+    """Load a CARMEN log or a bag (with the bag options), keeping the ``first`` scans;
+    ``reversing`` repairs a CARMEN log's steps that went forward while reversing.
 
     Raises:
         LogError: the log cannot be read.
@@ -124,7 +127,7 @@ def read_log(
     if first is not None and first < 2:
         raise error(f"--first must be at least 2, got {first}")
     if log.suffix in (".clf", ".gz", ".bz2"):
-        records = load_log(log)
+        records = load_log(log, reversing=reversing)
     else:
         records = load_log(
             log,

@@ -12,9 +12,11 @@ from roverlab.cli import (
     amcl_run,
     daemon,
     demo,
+    explore,
     graph,
     launch,
     nav,
+    patrol,
     run,
     service,
     sim,
@@ -48,6 +50,8 @@ app.add_typer(daemon.app, name="daemon")
 app.command("demo")(demo.demo)
 app.command("sim")(sim.sim)
 app.command("launch")(launch.launch)
+app.command("patrol")(patrol.patrol)
+app.command("explore")(explore.explore)
 app.command(
     "run",
     context_settings={"allow_extra_args": True, "ignore_unknown_options": True},

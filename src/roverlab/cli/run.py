@@ -3,15 +3,13 @@
 from __future__ import annotations
 
 import shlex
-import time
 from pathlib import Path
 from typing import Annotated
 
 import typer
 
-from roverlab.cli.common import NetworkOptions, network_options, run_context
+from roverlab.cli.common import connect_following_clock, network_options, run_context
 from roverlab.core import Context, Node, configure_logging
-from roverlab.core.transport.zenoh import ZenohTransport, query_graph
 from roverlab.description import find_package
 from roverlab.description.errors import DescriptionError
 from roverlab.errors import RoverlabError
@@ -20,34 +18,9 @@ from roverlab.launch.xml import NodeSpec
 from roverlab.ros1 import run_script
 from roverlab.ros1.rospy.runtime import parse_command_line
 
-CLOCKS = ("auto", "wall", "external")
-
 
 class RunError(RoverlabError):
     """``roverlab run`` cannot start what it was asked to."""
-
-
-def _connect(options: NetworkOptions, clock: str) -> tuple[ZenohTransport, str, str]:
-    """The transport, and the clock mode (``auto``: follow /clock when someone publishes
-    it, as a ROS node with /use_sim_time does next to a simulator; else wall time)."""
-    if clock not in CLOCKS:
-        raise RunError(f"unknown --clock {clock!r} ({', '.join(CLOCKS)})")
-    transport = ZenohTransport(options.zenoh_options())
-    if clock != "auto":
-        return transport, clock, ""
-    time.sleep(0.3)  # the router's declarations reach a fresh session first
-    deadline = time.monotonic() + 1.0
-    while True:
-        clocks = [
-            e
-            for e in query_graph(transport.session, transport.domain, 0.5)
-            if e.kind == "publisher" and e.topic == "/clock"
-        ]
-        if clocks:
-            return transport, "external", f"following /clock from {clocks[0].node} (sim time)"
-        if time.monotonic() >= deadline:
-            return transport, "wall", ""
-        time.sleep(0.2)
 
 
 def _resolve(target: list[str]) -> tuple[Path | None, NodeSpec | None, list[str]]:
@@ -109,7 +82,7 @@ def run(
     Options for roverlab go before the target; everything after it goes to the script.
     """
     script, spec, rest = _resolve(list(target) + list(ctx.args))
-    transport, mode, note = _connect(network_options(ctx), clock)
+    transport, mode, note = connect_following_clock(network_options(ctx), clock)
     if note:
         typer.echo(f"note: {note}", err=True)
     context = Context(clock=mode, publish_clock=False)

@@ -9,7 +9,6 @@ from typing import Annotated, NamedTuple
 
 import numpy as np
 import typer
-from PIL import Image, ImageDraw
 
 from roverlab.cli.log_input import (
     BaseFrameOption,
@@ -28,6 +27,7 @@ from roverlab.mapping.gmapping import GMapping, GMappingParams
 from roverlab.mapping.graph import GraphParams, GraphSLAM
 from roverlab.mapping.hector import HectorParams, HectorSLAM
 from roverlab.maps import save_map
+from roverlab.maps.plot import write_map_png
 from roverlab.slam.errors import SlamError
 from roverlab.slam.logs import LaserLog
 from roverlab.slam.trajectory import Trajectory, write_tum
@@ -118,36 +118,6 @@ def run_gmapping(
     return MethodResult(m.data, m.resolution, m.origin_xy, result.poses, traj, notes)
 
 
-def _png(path: Path, data: np.ndarray, resolution: float, origin: tuple[float, float],
-         poses: np.ndarray) -> None:  # fmt: skip
-    """The map (map_saver's grey levels, top row = max y) with the trajectory in red,
-    cropped to the known cells and the trajectory plus a margin (the .pgm keeps it all)."""
-    rows_k, cols_k = np.nonzero(data >= 0)
-    pc = (poses[:, 0] - origin[0]) / resolution
-    pr = (poses[:, 1] - origin[1]) / resolution
-    pad = 20
-    c0 = int(max(0, min(cols_k.min(initial=data.shape[1]), pc.min(initial=data.shape[1])) - pad))
-    c1 = int(min(data.shape[1], max(cols_k.max(initial=0), pc.max(initial=0)) + pad + 1))
-    r0 = int(max(0, min(rows_k.min(initial=data.shape[0]), pr.min(initial=data.shape[0])) - pad))
-    r1 = int(min(data.shape[0], max(rows_k.max(initial=0), pr.max(initial=0)) + pad + 1))
-    if c1 <= c0 or r1 <= r0:
-        c0, c1, r0, r1 = 0, data.shape[1], 0, data.shape[0]
-    data = data[r0:r1, c0:c1]
-    origin = (origin[0] + c0 * resolution, origin[1] + r0 * resolution)
-    img = np.full(data.shape, 205, dtype=np.uint8)
-    img[data == 0] = 254
-    img[data == 100] = 0
-    rgb = Image.fromarray(np.flipud(img)).convert("RGB")
-    draw = ImageDraw.Draw(rgb)
-    h = data.shape[0]
-    cols = (poses[:, 0] - origin[0]) / resolution
-    rows = h - 1 - (poses[:, 1] - origin[1]) / resolution
-    draw.line(list(zip(cols.tolist(), rows.tolist(), strict=True)), fill=(220, 30, 30), width=2)
-    tmp = path.with_name(path.name + ".part")
-    rgb.save(tmp, format="PNG")
-    tmp.replace(path)
-
-
 def run(
     log: LogArgument,
     method: Annotated[
@@ -209,7 +179,7 @@ def run(
     out.mkdir(parents=True, exist_ok=True)
     save_map(out / "map", res.data, resolution=res.resolution,
              origin=(res.origin[0], res.origin[1], 0.0))  # fmt: skip
-    _png(out / "map.png", res.data, res.resolution, res.origin, np.asarray(res.poses))
+    write_map_png(out / "map.png", res.data, res.resolution, res.origin, np.asarray(res.poses))
     write_tum(out / "trajectory.tum", res.trajectory)
     duration = float(records.timestamps[-1] - records.timestamps[0]) if len(records) > 1 else 0.0
     factor = duration / wall if wall > 0 else math.inf

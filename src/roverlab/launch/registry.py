@@ -28,6 +28,7 @@ from roverlab.mapping.hector.node import HectorMapping
 from roverlab.maps.node import MapSaver, MapServer
 from roverlab.msgs import classes as mc
 from roverlab.navigation.costmap.node import Costmap2DNode
+from roverlab.navigation.explore.node import Explore
 from roverlab.navigation.move_base.node import MoveBase
 from roverlab.viz.errors import DashboardError
 from roverlab.viz.launcher import start_rviz
@@ -294,6 +295,7 @@ REGISTRY[("costmap_2d", "costmap_2d_node")] = _slam_node(Costmap2DNode)
 REGISTRY[("amcl", "amcl")] = _slam_node(AmclNode)
 REGISTRY[("fake_localization", "fake_localization")] = _slam_node(FakeLocalization)
 REGISTRY[("move_base", "move_base")] = _slam_node(MoveBase)
+REGISTRY[("explore_lite", "explore")] = _slam_node(Explore)
 
 
 def _unavailable(reason: str) -> NodeFactory:

@@ -144,5 +144,5 @@ def cdr_size(msg: Any) -> int:
 def message_definition(typename: str) -> str:
     """The ``.msg`` text of a type with its dependencies (the ``ros2msg`` schema of MCAP
     files and ROS 2 bags)."""
-    text, _ = STORE.typestore.generate_msgdef(normalize_type_name(typename))
+    text, _ = STORE.typestore.generate_msgdef(STORE.resolve(normalize_type_name(typename)))
     return str(text)

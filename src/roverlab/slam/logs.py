@@ -42,6 +42,7 @@ from rosbags.highlevel import AnyReader, AnyReaderError
 from roverlab.geometry import SE2, wrap_angle, yaw_from_quat
 from roverlab.msgs import STORE
 from roverlab.slam.errors import LogError
+from roverlab.slam.reversing import ReversingRepair
 from roverlab.slam.trajectory import Trajectory
 
 __all__ = [
@@ -343,6 +344,7 @@ def read_clf(
     laser_message: str | None = None,
     range_min_m: float = 0.0,
     range_max_m: float | None = None,
+    reversing: ReversingRepair | None = None,
 ) -> Iterator[ScanRecord]:
     """Stream the front-laser scans of a CARMEN log (plain, gzip or bzip2).
 
@@ -374,6 +376,9 @@ def read_clf(
         range_min_m: ``range_min`` of the scans, m.
         range_max_m: ``range_max`` of the scans, m. Default: the line's maximum range
             (ROBOTLASER1, RAWLASER1) or :data:`CLF_RANGE_MAX_M` (FLASER).
+        reversing: repair odometry steps that went forward while ``ODOM``'s ``tv`` was
+            negative (see :mod:`roverlab.slam.reversing`; its counters tell how many);
+            None: the poses as logged.
 
     Yields:
         The scans in file order (pose-less scans once the odometry around them is read).
@@ -403,7 +408,11 @@ def read_clf(
                 if tag == "ODOM":
                     if len(parts) != 10:
                         raise ValueError(f"ODOM needs 9 values, got {len(parts) - 1}")
-                    stream.add(float(parts[7]), float(parts[1]), float(parts[2]), float(parts[3]))
+                    x, y, a = float(parts[1]), float(parts[2]), float(parts[3])
+                    if reversing is not None:
+                        fixed = reversing.odom(SE2(x, y, a), float(parts[4]))
+                        x, y, a = fixed.x, fixed.y, fixed.theta
+                    stream.add(float(parts[7]), x, y, a)
                     yield from stream.ready()
                     continue
                 if tag == "PARAM":
@@ -416,10 +425,13 @@ def read_clf(
                     chosen = tag
                 if tag != chosen:
                     continue
+                fix = _as_logged if reversing is None else reversing.scan
                 if tag == "FLASER":
-                    rec = _flaser(parts, range_min_m, range_max_m, stream, front_offset)
+                    rec = _flaser(parts, range_min_m, range_max_m, stream, front_offset, fix)
                 else:
-                    rec = _carmen_laser(parts, tag, range_min_m, range_max_m, stream, front_offset)
+                    rec = _carmen_laser(
+                        parts, tag, range_min_m, range_max_m, stream, front_offset, fix
+                    )
                 if rec is not None:
                     yield rec
         except (ValueError, IndexError) as err:
@@ -427,6 +439,10 @@ def read_clf(
         except (OSError, EOFError) as err:
             raise LogError(f"{p}:{lineno}: cannot read: {err}") from err
     yield from stream.drain()
+
+
+def _as_logged(pose: SE2) -> SE2:
+    return pose
 
 
 def _timestamp(parts: list[bytes]) -> tuple[float, str]:
@@ -443,6 +459,7 @@ def _flaser(
     range_max: float | None,
     stream: _PoseStream,
     front_offset: float,
+    fix: Callable[[SE2], SE2],
 ) -> ScanRecord | None:
     n = int(parts[1])
     if n < 0:
@@ -462,7 +479,7 @@ def _flaser(
 
     if has_pose:
         laser, odom = _pose(parts, n + 2), _pose(parts, n + 5)
-        return make(odom, ~odom * laser)
+        return make(fix(odom), ~odom * laser)
     offset = SE2(front_offset, 0.0, 0.0)
     stream.pending.append((t, lambda odom: make(odom, offset)))
     return None
@@ -475,6 +492,7 @@ def _carmen_laser(
     range_max: float | None,
     stream: _PoseStream,
     front_offset: float,
+    fix: Callable[[SE2], SE2],
 ) -> ScanRecord | None:
     start, res, max_range = float(parts[2]), float(parts[4]), float(parts[5])
     n = int(parts[8])
@@ -497,7 +515,7 @@ def _carmen_laser(
     if tag == "ROBOTLASER1":
         k = 10 + n + m
         laser, odom = _pose(parts, k), _pose(parts, k + 3)
-        return make(odom, ~odom * laser)
+        return make(fix(odom), ~odom * laser)
     offset = SE2(front_offset, 0.0, 0.0)
     stream.pending.append((t, lambda odom: make(odom, offset)))
     return None

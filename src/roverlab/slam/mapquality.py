@@ -55,6 +55,7 @@ __all__ = [
     "MapQuality",
     "MapQualityError",
     "OccupancyMapLike",
+    "ReachableArea",
     "align_map",
     "evaluate_map",
     "grid_from_msg",
@@ -447,25 +448,48 @@ def _coverage(
     grid: OccupancyMapLike, gt: GroundTruth, pose: SE2, known: NDArray[np.bool_]
 ) -> float:
     """Fraction of the true free cells reachable from the map origin that the map knows."""
-    labels, _ = ndimage.label(~gt.occupied)
-    start = np.array([[pose.x, pose.y]])
-    r0, c0, inside = _gt_cells(start, gt)
-    if not inside[0] or labels[r0[0], c0[0]] == 0:
-        return 0.0
-    region = labels == labels[r0[0], c0[0]]
-    rows, cols = np.nonzero(region)
-    res = gt.resolution
-    pts = np.empty((rows.size, 2))
-    pts[:, 0] = gt.origin_xy[0] + (cols + 0.5) * res
-    pts[:, 1] = gt.origin_xy[1] + (rows + 0.5) * res
-    local = _to_world(pts, ~pose)  # world -> map frame
-    mc = np.floor((local[:, 0] - grid.origin_xy[0]) / grid.resolution).astype(np.intp)
-    mr = np.floor((local[:, 1] - grid.origin_xy[1]) / grid.resolution).astype(np.intp)
-    h, w = known.shape
-    ok = (mr >= 0) & (mr < h) & (mc >= 0) & (mc < w)
-    seen = np.zeros(rows.size, dtype=bool)
-    seen[ok] = known[mr[ok], mc[ok]]
-    return float(seen.mean())
+    return ReachableArea(gt, pose).known_fraction(grid, known)
+
+
+class ReachableArea:
+    """The ground truth's free cells reachable (4-connected) from the map frame's origin,
+    as points in the map frame: what share of them a map knows, however it grows.
+
+    Args:
+        gt: the ground truth.
+        world_T_map: the map frame's pose in the world (the robot's spawn pose).
+    """
+
+    def __init__(self, gt: GroundTruth, world_T_map: SE2) -> None:
+        labels, _ = ndimage.label(~gt.occupied)
+        r0, c0, inside = _gt_cells(np.array([[world_T_map.x, world_T_map.y]]), gt)
+        if not inside[0] or labels[r0[0], c0[0]] == 0:
+            rows = cols = np.zeros(0, dtype=np.intp)
+        else:
+            rows, cols = np.nonzero(labels == labels[r0[0], c0[0]])
+        res = gt.resolution
+        pts = np.empty((rows.size, 2))
+        pts[:, 0] = gt.origin_xy[0] + (cols + 0.5) * res
+        pts[:, 1] = gt.origin_xy[1] + (rows + 0.5) * res
+        self.points = _to_world(pts, ~world_T_map)  # world -> map frame
+        #: the reachable free area (m^2)
+        self.area_m2 = float(rows.size * res * res)
+
+    def known_fraction(
+        self, grid: OccupancyMapLike, known: NDArray[np.bool_] | None = None
+    ) -> float:
+        """Share of the reachable cells that ``grid`` knows (``known``: its known-cell
+        mask; default: occupied or free by :func:`evaluate_map`'s thresholds)."""
+        if not len(self.points):
+            return 0.0
+        if known is None:
+            occ, free = _classify(grid, _OCCUPIED_THRESHOLD, _FREE_THRESHOLD)
+            known = occ | free
+        mc = np.floor((self.points[:, 0] - grid.origin_xy[0]) / grid.resolution).astype(np.intp)
+        mr = np.floor((self.points[:, 1] - grid.origin_xy[1]) / grid.resolution).astype(np.intp)
+        h, w = known.shape
+        ok = (mr >= 0) & (mr < h) & (mc >= 0) & (mc < w)
+        return float(np.count_nonzero(known[mr[ok], mc[ok]]) / len(self.points))
 
 
 def write_overlay_png(

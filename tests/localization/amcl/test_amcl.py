@@ -67,7 +67,7 @@ def test_amcl_step_rules_for_beams() -> None:
 
 
 def test_update_gating_resample_interval_and_publication() -> None:
-    amcl = _amcl()
+    amcl = _amcl(resample_interval=2)  # ROS's interval (roverlab's default is 1)
     odom = SE2(0.0, 0.0, 0.0)
 
     def scan(pose: SE2) -> Any:
@@ -90,6 +90,10 @@ def test_update_gating_resample_interval_and_publication() -> None:
     still = scan(SE2(0.21, 0.0, 0.6))  # the request is used up
     assert not still.updated
     assert amcl.updates == 4
+    every = _amcl()  # resample_interval 1: every update resamples and publishes, the first too
+    first = every.process_scan(odom_pose=odom, ranges=scan_at(SE2(1.0, 0.7, 0.0)),
+                               bearings=BEARINGS, range_max=10.0)  # fmt: skip
+    assert first.updated and first.resampled and first.estimate is not None
 
 
 def test_tracking_a_drive_from_an_offset_start() -> None:
@@ -106,9 +110,15 @@ def test_tracking_a_drive_from_an_offset_start() -> None:
     "params",
     [
         {"laser_model_type": "beam"},
-        {"laser_model_type": "likelihood_field_prob"},
-        {"laser_model_type": "likelihood_field_prob", "do_beamskip": True},
-        {"odom_model_type": "diff-corrected"},
+        {"laser_model_type": "likelihood_field"},
+        {"do_beamskip": True},
+        {"odom_model_type": "diff"},
+        {  # ROS 1 amcl's defaults
+            "laser_model_type": "likelihood_field",
+            "laser_sigma_hit": 0.2,
+            "odom_model_type": "diff",
+            "resample_interval": 2,
+        },
         {"odom_model_type": "omni"},
         {"odom_model_type": "omni-corrected"},
         {"selective_resampling": True, "resample_interval": 1},

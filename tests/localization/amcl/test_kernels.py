@@ -72,24 +72,46 @@ def test_likelihood_field_prob_is_the_product_and_beamskip_drops_disagreeing_bea
                              0.3 + rng.normal(0, 0.01, 50)])  # fmt: skip
     w = np.ones(50)
     args = (log_t, log_off, m.distance, 1 / RES, *ORIGIN)
-    likelihood_field_prob_weights(poses, w, ex, ey, *args, False, 0.5, 0.3, 0.9,
-                                  np.empty((0, 0)))  # fmt: skip
+    _, scale, _, _ = likelihood_field_prob_weights(poses, w, ex, ey, *args, False, 0.5, 0.3,
+                                                   0.9, np.empty((0, 0)))  # fmt: skip
     hx, hy = _endpoints(SE2(*poses[0]), ex, ey)
-    assert w[0] == pytest.approx(np.prod(_pz(m, hx, hy)))
+    # the weights come scaled by exp(-max log p): the heaviest particle gets exactly 1
+    assert w[0] * math.exp(scale) == pytest.approx(np.prod(_pz(m, hx, hy)))
+    assert w.max() == 1.0
     w2 = np.ones(50)
-    total, skipped, too_many = likelihood_field_prob_weights(
+    total, scale2, skipped, too_many = likelihood_field_prob_weights(
         poses, w2, ex, ey, *args, True, 0.2, 0.3, 0.9, np.empty((50, len(ex)))
     )
     assert skipped == 1 and not too_many  # only the person's beam disagrees with the map
-    assert w2[0] == pytest.approx(np.prod(_pz(m, hx[1:], hy[1:])))
+    assert w2[0] * math.exp(scale2) == pytest.approx(np.prod(_pz(m, hx[1:], hy[1:])))
     assert total == pytest.approx(w2.sum())
     # most beams disagreeing: the filter may be wrong; amcl then uses them all
     w3 = np.ones(50)
-    _, skipped3, too_many3 = likelihood_field_prob_weights(
+    _, _, skipped3, too_many3 = likelihood_field_prob_weights(
         poses + np.array([1.0, 0.7, 1.0]), w3, ex, ey, *args, True, 0.05, 0.3, 0.2,
         np.empty((50, len(ex))),
     )  # fmt: skip
     assert too_many3 and skipped3 == 0
+
+
+def test_likelihood_field_prob_does_not_underflow_with_many_beams() -> None:
+    """360 beams of a pose 1 m off: each pz is tiny and their product underflows to zero
+    (amcl's weights all become 0); in the log domain the better pose still wins."""
+    m = room_map()
+    log_t, log_off = m.log_likelihood_table(z_hit=Z_HIT, z_rand=Z_RAND, sigma_hit=0.05,
+                                            range_max=RMAX)  # fmt: skip
+    ex, ey = _beams(SE2(2.6, 2.0, 0.3), every=1)
+    ex, ey = np.tile(ex, 4), np.tile(ey, 4)
+    poses = np.array([[3.5, 2.8, 0.3], [3.4, 2.8, 0.3]])
+    hx, hy = _endpoints(SE2(*poses[0]), ex, ey)
+    assert np.prod(_pz(m, hx, hy)) == 0.0  # what a direct product gives
+    w = np.full(2, 0.5)
+    total, scale, _, _ = likelihood_field_prob_weights(
+        poses, w, ex, ey, log_t, log_off, m.distance, 1 / RES, *ORIGIN, False, 0.5, 0.3, 0.9,
+        np.empty((0, 0)),
+    )  # fmt: skip
+    assert total > 0.0 and np.isfinite(scale) and scale < -745.0
+    assert w.max() == 0.5 and total == pytest.approx(w.sum())
 
 
 def test_beam_model_mixture() -> None:

@@ -156,6 +156,10 @@ def test_parameters_have_the_ros_names_and_defaults() -> None:
     for name, value in AmclParams().to_ros().items():
         assert node.get_parameter(name).value == value
     assert node.params == AmclParams() and node.get_parameter("seed").value == 0
+    # the odometry model's alphas: a launch file choosing ROS's diff gets ROS's 0.2
+    diff = AmclNode(Context(), parameter_overrides={"odom_model_type": "diff"})
+    assert diff.get_parameter("odom_alpha1").value == 0.2
+    assert diff.params.odom_alphas == (0.2,) * 5
 
 
 def test_initialpose_reinitialises_and_wrong_frames_are_ignored(
@@ -175,7 +179,9 @@ def test_initialpose_reinitialises_and_wrong_frames_are_ignored(
     ctx.spin_for(0.5)
     assert node.amcl is not None
     cloud = node.amcl.pf.poses
-    assert np.hypot(cloud[:, 0].mean() - 4.6, cloud[:, 1].mean() - 2.9) < 0.1
+    # around the given pose (the scan after it already pulls the cloud 0.1 m to the truth)
+    assert np.hypot(cloud[:, 0].mean() - 4.6, cloud[:, 1].mean() - 2.9) < 0.2
+    assert np.ptp(cloud[:, 0]) < 1.0
     est = _estimate(node, robot)
     assert math.hypot(est.x - 4.5, est.y - 3.0) < 0.2
     with caplog.at_level(logging.WARNING, logger="roverlab"):
@@ -204,7 +210,7 @@ def test_services_global_localization_nomotion_update_and_set_map(tmp_path: Path
     for _ in range(30):  # no-motion updates: the global filter narrows down where it stands
         nomotion.call(nomotion.srv_type.Request())
         ctx.spin_for(0.1)
-    assert node.amcl.updates >= updates + 25 and node.amcl.pf.count < 5000
+    assert node.amcl.updates >= updates + 25 and np.ptp(node.amcl.pf.poses[:, 0]) < 1.0
     # set_map: a new map (the room shifted by 1 m) with a pose in it
     set_map = caller.create_client("nav_msgs/srv/SetMap", "set_map")
     req = set_map.srv_type.Request()

@@ -10,27 +10,39 @@ import pytest
 from roverlab.localization.amcl import AmclParams, AmclParamsError
 
 
-def test_defaults_are_the_ros_wiki_values() -> None:
+def test_defaults_are_the_ros_wiki_values_except_five() -> None:
     p = AmclParams()
     expected = {
         "min_particles": 100, "max_particles": 5000, "kld_err": 0.01, "kld_z": 0.99,
-        "update_min_d": 0.2, "update_min_a": math.pi / 6, "resample_interval": 2,
+        "update_min_d": 0.2, "update_min_a": math.pi / 6, "resample_interval": 1,
         "transform_tolerance": 0.1, "recovery_alpha_slow": 0.0, "recovery_alpha_fast": 0.0,
         "initial_cov_xx": 0.25, "initial_cov_yy": 0.25, "initial_cov_aa": (math.pi / 12) ** 2,
         "gui_publish_rate": -1.0, "save_pose_rate": 0.5, "use_map_topic": False,
         "first_map_only": False, "selective_resampling": False, "tf_broadcast": True,
         "laser_min_range": -1.0, "laser_max_range": -1.0, "laser_max_beams": 30,
         "laser_z_hit": 0.95, "laser_z_short": 0.1, "laser_z_max": 0.05, "laser_z_rand": 0.05,
-        "laser_sigma_hit": 0.2, "laser_lambda_short": 0.1, "laser_likelihood_max_dist": 2.0,
-        "laser_model_type": "likelihood_field", "do_beamskip": False,
+        "laser_sigma_hit": 0.1, "laser_lambda_short": 0.1, "laser_likelihood_max_dist": 2.0,
+        "laser_model_type": "likelihood_field_prob", "do_beamskip": False,
         "beam_skip_distance": 0.5, "beam_skip_threshold": 0.3,
-        "beam_skip_error_threshold": 0.9, "odom_model_type": "diff", "odom_alpha5": 0.2,
+        "beam_skip_error_threshold": 0.9, "odom_model_type": "diff-corrected",
         "odom_frame_id": "odom", "base_frame_id": "base_link", "global_frame_id": "map",
     }  # fmt: skip
     for name, value in expected.items():
         assert getattr(p, name) == pytest.approx(value), name
-    assert p.odom_alphas == (0.2, 0.2, 0.2, 0.2, 0.2)
+    assert p.odom_alphas == (0.02, 0.02, 0.02, 0.02, 0.02)
     assert AmclParams.from_ros(p.to_ros()) == p
+
+
+def test_the_alphas_default_to_the_chosen_models_and_given_values_are_kept() -> None:
+    # a launch file that picks ROS's original model gets ROS's alphas
+    assert AmclParams.from_ros({"odom_model_type": "diff"}).odom_alphas == (0.2,) * 5
+    assert AmclParams(odom_model_type="omni").odom_alphas == (0.2,) * 5
+    assert AmclParams.from_ros({"odom_model_type": "omni-corrected"}).odom_alphas == (0.02,) * 5
+    p = AmclParams.from_ros({"odom_model_type": "diff", "odom_alpha2": 0.5, "odom_alpha3": -1})
+    assert p.odom_alphas == (0.2, 0.5, 0.2, 0.2, 0.2)  # -1: the model's default
+    assert AmclParams.default_of("odom_alpha4", "diff") == 0.2
+    assert AmclParams.default_of("odom_alpha4", "diff-corrected") == 0.02
+    assert AmclParams.default_of("laser_sigma_hit", "diff") == 0.1
 
 
 def test_from_ros_coerces_numbers_and_drops_ignored_names() -> None:

@@ -90,6 +90,22 @@ def test_recovery_injects_random_particles_when_the_fast_average_drops() -> None
     assert pf.w_slow > 0 and pf.w_fast < pf.w_slow
 
 
+def test_product_likelihoods_are_averaged_per_beam() -> None:
+    """A product over 30 beams swings by orders of magnitude with what the laser sees; the
+    averages take its 30th root (the geometric mean pz per beam), given in log form."""
+    pf = _pf(alpha_slow=0.001, alpha_fast=0.1)
+    pf.init_gaussian((2.6, 2.1, 0.3), np.diag([1e-4, 1e-4, 1e-4]))
+    rng = np.random.default_rng(1)
+    for _ in range(200):  # well localised: log p per beam about log 0.8, +-20% per scan
+        log_p = 30 * math.log(0.8 * (1.0 + 0.2 * rng.uniform(-1, 1)))
+        pf.normalise(float(pf.weights.sum()), log_scale=log_p, beams=30)
+    assert pf.w_slow == pytest.approx(0.8, rel=0.05)
+    assert 1.0 - pf.w_fast / pf.w_slow < 0.15  # little injection while tracking
+    for _ in range(10):  # kidnapped: pz per beam 0.1
+        pf.normalise(float(pf.weights.sum()), log_scale=30 * math.log(0.1), beams=30)
+    assert 1.0 - pf.w_fast / pf.w_slow > 0.5
+
+
 def test_zero_rates_never_inject() -> None:
     pf = _pf()
     pf.init_gaussian((2.6, 2.1, 0.3), np.diag([1e-3, 1e-3, 1e-3]))
@@ -140,6 +156,37 @@ def test_clusters_and_convergence() -> None:
     pf.init_gaussian((2.6, 2.1, 0.3), np.diag([1e-3, 1e-3, 1e-3]))
     pf.resample()
     assert pf.converged
+
+
+def _root(parent: list[int], i: int) -> int:
+    while parent[i] != i:
+        i = parent[i]
+    return i
+
+
+def test_clusters_join_touching_bins_as_a_brute_force_reference() -> None:
+    rng = np.random.default_rng(7)
+    for n, side in ((80, 12.0), (2000, 30.0)):
+        poses = np.column_stack([rng.uniform(0, side, n), rng.uniform(0, side, n),
+                                 rng.uniform(-math.pi, math.pi, n)])  # fmt: skip
+        pf = _pf()
+        pf.poses = poses
+        pf.weights = np.full(n, 1 / n)
+        labels = pf.clusters().labels
+        ix = np.floor(poses[:, 0] / 0.5).astype(int)
+        iy = np.floor(poses[:, 1] / 0.5).astype(int)
+        ia = np.floor((poses[:, 2] + math.pi) / math.radians(10.0)).astype(int) % 36
+        parent = list(range(n))
+
+        da = np.abs(ia[:, None] - ia[None, :])
+        touch = ((np.abs(ix[:, None] - ix[None, :]) <= 1) & (np.abs(iy[:, None] - iy[None, :]) <= 1)
+                 & (np.minimum(da, 36 - da) <= 1))  # fmt: skip
+        for i, j in zip(*np.nonzero(touch), strict=True):
+            parent[_root(parent, int(i))] = _root(parent, int(j))
+        ref = np.array([_root(parent, i) for i in range(n)])
+        same = ref[:, None] == ref[None, :]
+        assert np.array_equal(same, labels[:, None] == labels[None, :])
+        assert len(set(labels.tolist())) == len(set(ref.tolist())) > 5
 
 
 def test_seeded_filters_repeat_and_different_seeds_differ() -> None:

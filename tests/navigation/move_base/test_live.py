@@ -123,11 +123,11 @@ def test_a_new_goal_preempts_the_current_one(stack: Stack) -> None:
     ends: list[tuple[int, str]] = []
     s.client.send_goal(_goal(-2.0, -2.0, math.pi), done_cb=lambda st, r: ends.append((st, "first")))
     s.ctx.spin_for(3.0)
-    other.send_goal(_goal(0.5, -0.3, 0.0))
+    other.send_goal(_goal(-0.5, -0.5, 0.0))
     assert other.wait_for_result(120.0) and other.get_state() == GoalStatus.SUCCEEDED
     assert ends == [(GoalStatus.PREEMPTED, "first")]
     assert s.client.get_goal_status_text() == BUMPED
-    assert _at(s, 0.5, -0.3, 0.0)
+    assert _at(s, -0.5, -0.5, 0.0)
 
 
 def test_cancel_stops_the_robot(stack: Stack) -> None:
@@ -168,9 +168,9 @@ def test_rviz_2d_nav_goal_make_plan_and_clear_costmaps(stack: Stack) -> None:
     s = stack
     node = s.ctx.create_node("rviz")
     pub = node.create_publisher("geometry_msgs/PoseStamped", "/move_base_simple/goal", 1)
-    pub.publish(_pose_stamped(0.6, -0.4, 0.0))
+    pub.publish(_pose_stamped(-0.5, 0.4, 0.0))
     s.ctx.wait_for(lambda: s.move_base.goals_succeeded == 1, 60.0)
-    assert _at(s, 0.6, -0.4, 0.0)
+    assert _at(s, -0.5, 0.4, 0.0)
     make_plan = node.create_client("nav_msgs/GetPlan", "/move_base/make_plan")
     req = make_plan.srv_type.Request(goal=_pose_stamped(2.0, 0.0, 0.0), tolerance=0.0)
     plan = make_plan.call(req).plan

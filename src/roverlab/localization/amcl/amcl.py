@@ -367,12 +367,12 @@ class Amcl:
             if self._scratch.size < size:
                 self._scratch = np.empty(size)
             scratch = self._scratch[:size].reshape(pf.count, ex.shape[0])
-        total, skipped, too_many = likelihood_field_prob_weights(
+        total, log_scale, skipped, too_many = likelihood_field_prob_weights(
             pf.poses, pf.weights, ex, ey, log_table, log_off, m.distance, inv, ox, oy, skip,
             p.beam_skip_distance, p.beam_skip_threshold, p.beam_skip_error_threshold, scratch,
         )  # fmt: skip
-        pf.normalise(total)
         used = int(ex.shape[0]) - int(skipped)
+        pf.normalise(total, log_scale=log_scale, beams=used)
         if too_many:
             return used, (
                 f"over {100.0 * p.beam_skip_error_threshold:.0f}% of the beams disagree with "

@@ -1,4 +1,5 @@
-"""amcl's compiled kernels: motion models, particle weighting, KLD resampling, clusters.
+"""amcl's compiled kernels: motion models, particle weighting, KLD resampling (clusters:
+:mod:`.clusters`).
 
 Every kernel is ``numba.njit(cache=True, nogil=True)`` over plain arrays; kernels that
 draw take the caller's ``np.random.Generator`` (numba draws from its state, the same
@@ -27,7 +28,6 @@ __all__ = [
     "BIN_ANGLE_RAD",
     "BIN_XY_M",
     "beam_weights",
-    "cluster_stats",
     "diff_motion",
     "kld_resample",
     "likelihood_field_prob_weights",
@@ -117,8 +117,11 @@ def likelihood_field_prob_weights(
     skip_threshold: float,
     skip_error_threshold: float,
     scratch: F64,
-) -> tuple[float, int, bool]:
-    """amcl's ``likelihood_field_prob`` model: ``w *= exp(sum_beams log pz)``.
+) -> tuple[float, float, int, bool]:
+    """amcl's ``likelihood_field_prob`` model: ``w *= exp(sum_beams log pz)``, computed in
+    the log domain: each particle's ``log p`` is found first and the weights are multiplied
+    by ``exp(log p - max log p)``, so that a product of many small ``pz`` does not
+    underflow to zero for every particle (amcl multiplies ``pz`` directly).
 
     With ``beamskip``, a beam is used only when more than ``skip_threshold`` of the
     particles see its end point within ``skip_distance`` of an obstacle; when at least
@@ -132,19 +135,20 @@ def likelihood_field_prob_weights(
         (others as :func:`likelihood_field_weights`)
 
     Returns:
-        ``(sum of weights, beams skipped, all beams used because too many disagreed)``.
+        ``(sum of weights, max log p, beams skipped, all beams used because too many
+        disagreed)``: the weights were multiplied by ``p / exp(max log p)``.
     """
     h, w = log_table.shape
     nb = ex.shape[0]
     n = poses.shape[0]
     agree = np.zeros(nb, dtype=np.int64)
-    total = 0.0
+    log_p = np.empty(n)
     for j in range(n):
         gx = (poses[j, 0] - ox) * inv_res
         gy = (poses[j, 1] - oy) * inv_res
         c = math.cos(poses[j, 2]) * inv_res
         s = math.sin(poses[j, 2]) * inv_res
-        log_p = 0.0
+        acc = 0.0
         for i in range(nb):
             hx = gx + c * ex[i] - s * ey[i]
             hy = gy + s * ex[i] + c * ey[i]
@@ -152,34 +156,41 @@ def likelihood_field_prob_weights(
                 r = int(hy)
                 q = int(hx)
                 v = log_table[r, q]
-                if distance[r, q] < skip_distance:
+                if beamskip and distance[r, q] < skip_distance:
                     agree[i] += 1
             else:
                 v = off_map
             if beamskip:
                 scratch[j, i] = v
             else:
-                log_p += v
-        if not beamskip:
-            weights[j] *= math.exp(log_p)
-            total += weights[j]
-    if not beamskip:
-        return total, 0, False
-    use = np.empty(nb, dtype=np.bool_)
+                acc += v
+        log_p[j] = acc
     skipped = 0
-    for i in range(nb):
-        use[i] = agree[i] / n > skip_threshold
-        if not use[i]:
-            skipped += 1
-    too_many = skipped >= nb * skip_error_threshold
-    for j in range(n):
-        log_p = 0.0
+    too_many = False
+    if beamskip:
+        use = np.empty(nb, dtype=np.bool_)
         for i in range(nb):
-            if too_many or use[i]:
-                log_p += scratch[j, i]
-        weights[j] *= math.exp(log_p)
+            use[i] = agree[i] / n > skip_threshold
+            if not use[i]:
+                skipped += 1
+        too_many = skipped >= nb * skip_error_threshold
+        for j in range(n):
+            acc = 0.0
+            for i in range(nb):
+                if too_many or use[i]:
+                    acc += scratch[j, i]
+            log_p[j] = acc
+    top = 0.0
+    found = False
+    for j in range(n):
+        if weights[j] > 0.0 and (not found or log_p[j] > top):
+            top = log_p[j]
+            found = True
+    total = 0.0
+    for j in range(n):
+        weights[j] *= math.exp(log_p[j] - top)
         total += weights[j]
-    return total, (0 if too_many else skipped), too_many
+    return total, top, (0 if too_many else skipped), too_many
 
 
 @_jit
@@ -411,121 +422,8 @@ def omni_motion(
 
 @_jit
 def _wrap(a: float) -> float:
+    """``a`` in ``[-pi, pi)`` (as it is when it already lies there: no floating-point
+    modulo on the common path)."""
+    if -math.pi <= a < math.pi:
+        return a
     return (a + math.pi) % (2.0 * math.pi) - math.pi
-
-
-@_jit
-def cluster_stats(
-    poses: F64, weights: F64
-) -> tuple[I64, F64, F64, F64, NDArray[np.int64], F64, F64]:
-    """amcl's ``pf_cluster_stats``: histogram bins joined into clusters by adjacency (the
-    26 neighbouring bins), then each cluster's weight, mean and covariance.
-
-    Means of yaw are circular (``atan2`` of the weighted sines and cosines) and the yaw
-    variance is ``-2 log R`` (``R``: the mean resultant length of the cluster's weights).
-
-    Returns:
-        ``(labels (N,), weight (C,), mean (C, 3), cov (C, 3, 3), count (C,),
-        set mean (3,), set cov (3, 3))``.
-    """
-    n = poses.shape[0]
-    keys = np.empty(n, dtype=np.int64)
-    for j in range(n):
-        keys[j] = _bin_key(poses[j, 0], poses[j, 1], poses[j, 2])
-    order = np.argsort(keys)
-    uniq = np.empty(n, dtype=np.int64)
-    of_particle = np.empty(n, dtype=np.int64)
-    nu = 0
-    for r in range(n):
-        j = order[r]
-        if nu == 0 or keys[j] != uniq[nu - 1]:
-            uniq[nu] = keys[j]
-            nu += 1
-        of_particle[j] = nu - 1
-    uniq = uniq[:nu]
-    label = np.full(nu, -1, dtype=np.int64)
-    stack = np.empty(nu, dtype=np.int64)
-    clusters = 0
-    for b in range(nu):
-        if label[b] >= 0:
-            continue
-        label[b] = clusters
-        top = 0
-        stack[top] = b
-        top += 1
-        while top > 0:
-            top -= 1
-            cur = uniq[stack[top]]
-            kx = cur >> 42
-            ky = (cur >> 21) & _MASK
-            ka = cur & _MASK
-            for dx in range(-1, 2):
-                for dy in range(-1, 2):
-                    for da in range(-1, 2):
-                        if dx == 0 and dy == 0 and da == 0:
-                            continue
-                        na = (ka + da) % ANGLE_BINS
-                        nk = ((kx + dx) << 42) | ((ky + dy) << 21) | na
-                        pos = np.searchsorted(uniq, nk)
-                        if pos < nu and uniq[pos] == nk and label[pos] < 0:
-                            label[pos] = clusters
-                            stack[top] = pos
-                            top += 1
-        clusters += 1
-    labels = np.empty(n, dtype=np.int64)
-    cw = np.zeros(clusters)
-    count = np.zeros(clusters, dtype=np.int64)
-    m = np.zeros((clusters, 4))
-    cc = np.zeros((clusters, 2, 2))
-    sm = np.zeros(4)
-    sc = np.zeros((2, 2))
-    total = 0.0
-    for j in range(n):
-        c = label[of_particle[j]]
-        labels[j] = c
-        wj = weights[j]
-        x = poses[j, 0]
-        y = poses[j, 1]
-        ca = math.cos(poses[j, 2])
-        sa = math.sin(poses[j, 2])
-        count[c] += 1
-        cw[c] += wj
-        total += wj
-        m[c, 0] += wj * x
-        m[c, 1] += wj * y
-        m[c, 2] += wj * ca
-        m[c, 3] += wj * sa
-        sm[0] += wj * x
-        sm[1] += wj * y
-        sm[2] += wj * ca
-        sm[3] += wj * sa
-        cc[c, 0, 0] += wj * x * x
-        cc[c, 0, 1] += wj * x * y
-        cc[c, 1, 1] += wj * y * y
-        sc[0, 0] += wj * x * x
-        sc[0, 1] += wj * x * y
-        sc[1, 1] += wj * y * y
-    mean = np.zeros((clusters, 3))
-    cov = np.zeros((clusters, 3, 3))
-    for c in range(clusters):
-        if cw[c] <= 0.0:
-            continue
-        _moments(m[c], cc[c], cw[c], mean[c], cov[c])
-    set_mean = np.zeros(3)
-    set_cov = np.zeros((3, 3))
-    if total > 0.0:
-        _moments(sm, sc, total, set_mean, set_cov)
-    return labels, cw, mean, cov, count, set_mean, set_cov
-
-
-@_jit
-def _moments(m: F64, c: F64, w: float, mean: F64, cov: F64) -> None:
-    mean[0] = m[0] / w
-    mean[1] = m[1] / w
-    mean[2] = math.atan2(m[3], m[2])
-    cov[0, 0] = c[0, 0] / w - mean[0] * mean[0]
-    cov[0, 1] = c[0, 1] / w - mean[0] * mean[1]
-    cov[1, 0] = cov[0, 1]
-    cov[1, 1] = c[1, 1] / w - mean[1] * mean[1]
-    resultant = math.sqrt(m[2] * m[2] + m[3] * m[3]) / w
-    cov[2, 2] = -2.0 * math.log(resultant) if resultant > 0.0 else math.inf

@@ -108,10 +108,10 @@ class AmclNode(Node):
 
     def __init__(self, context: Context, *, node_name: str = "amcl", **node_kwargs: Any) -> None:
         super().__init__(node_name, context=context, **node_kwargs)
-        values = {
-            f.name: self.declare_parameter(f.name, f.default).value
-            for f in dataclasses.fields(AmclParams)
-        }
+        values: dict[str, Any] = {}
+        for f in dataclasses.fields(AmclParams):  # odom_model_type before the alphas
+            default = AmclParams.default_of(f.name, str(values.get("odom_model_type", "")))
+            values[f.name] = self.declare_parameter(f.name, default).value
         self.params = AmclParams.from_ros(values)
         p = self.params
         self.rng = np.random.default_rng(int(self.declare_parameter("seed", 0).value))

@@ -1,4 +1,5 @@
-"""Parameters of ROS 1 ``amcl``, with its names and the defaults of its wiki page.
+"""Parameters of ROS 1 ``amcl``, with its names and the defaults of its wiki page (except
+where roverlab chose better ones; see :class:`AmclParams`).
 
 Every ``<param>`` an amcl ``.launch`` or ``amcl_params.yaml`` sets is a field of
 :class:`AmclParams`, named as ROS names it (``min_particles``, ``laser_z_hit``,
@@ -24,7 +25,9 @@ from roverlab.localization.amcl.errors import AmclParamsError
 __all__ = [
     "IGNORED_PARAMETERS",
     "LASER_MODELS",
+    "MODEL_DEFAULT",
     "NODE_PARAMETERS",
+    "ODOM_ALPHA_DEFAULTS",
     "ODOM_MODELS",
     "AmclParams",
 ]
@@ -33,6 +36,19 @@ __all__ = [
 LASER_MODELS: Final = ("likelihood_field", "beam", "likelihood_field_prob")
 #: ``odom_model_type`` values.
 ODOM_MODELS: Final = ("diff", "omni", "diff-corrected", "omni-corrected")
+
+#: ``odom_alpha1..5`` value that stands for the odometry model's default.
+MODEL_DEFAULT: Final = -1.0
+#: The default ``odom_alpha1..5`` of each ``odom_model_type``: ROS's 0.2 for the original
+#: models, whose noise is ``alpha * motion^2`` used as a standard deviation; 0.02 for the
+#: corrected ones, whose standard deviation is ``sqrt(alpha) * motion`` (ROS keeps 0.2,
+#: a 45% error on every motion; its wiki says to lower them).
+ODOM_ALPHA_DEFAULTS: Final = {
+    "diff": 0.2,
+    "omni": 0.2,
+    "diff-corrected": 0.02,
+    "omni-corrected": 0.02,
+}
 
 #: Fields of :class:`AmclParams` that only the node uses.
 NODE_PARAMETERS: Final = frozenset(
@@ -68,6 +84,14 @@ _MAX_PARTICLES = 1_000_000
 @dataclass(frozen=True, slots=True, kw_only=True)
 class AmclParams:
     """amcl's parameters (ROS names and defaults; metres, radians, seconds, hertz).
+
+    roverlab's defaults differ from ROS's in five places (docs/localization.md gives the
+    evidence): ``odom_model_type`` ``diff-corrected`` (ROS ``diff``, which uses variances
+    as standard deviations), ``odom_alpha1..5`` the model's default from
+    :data:`ODOM_ALPHA_DEFAULTS` (ROS 0.2 for every model), ``laser_model_type``
+    ``likelihood_field_prob`` (ROS ``likelihood_field``, whose ``1 + sum pz^3`` barely
+    tells poses apart), ``laser_sigma_hit`` 0.1 (ROS 0.2) and ``resample_interval`` 1
+    (ROS 2: the pose is published only after resampling). A value given is always used.
 
     Attributes:
         min_particles: fewest particles KLD sampling keeps.
@@ -110,11 +134,12 @@ class AmclParams:
         beam_skip_threshold: share of particles that must agree for a beam to be used.
         beam_skip_error_threshold: when this share of beams is skipped, use them all.
         odom_model_type: ``diff``, ``omni``, ``diff-corrected`` or ``omni-corrected``.
-        odom_alpha1: rotation noise from rotation.
-        odom_alpha2: rotation noise from translation.
-        odom_alpha3: translation noise from translation.
-        odom_alpha4: translation noise from rotation.
-        odom_alpha5: strafe noise from translation (omni models).
+        odom_alpha1: rotation noise from rotation (-1: the model's default, see
+            :data:`ODOM_ALPHA_DEFAULTS`).
+        odom_alpha2: rotation noise from translation (-1: the model's default).
+        odom_alpha3: translation noise from translation (-1: the model's default).
+        odom_alpha4: translation noise from rotation (-1: the model's default).
+        odom_alpha5: strafe noise from translation, omni models (-1: the model's default).
         odom_frame_id: the odometry frame (node).
         base_frame_id: the robot frame (node).
         global_frame_id: the map frame (node).
@@ -129,7 +154,7 @@ class AmclParams:
     kld_z: float = 0.99
     update_min_d: float = 0.2
     update_min_a: float = math.pi / 6.0
-    resample_interval: int = 2
+    resample_interval: int = 1
     transform_tolerance: float = 0.1
     recovery_alpha_slow: float = 0.0
     recovery_alpha_fast: float = 0.0
@@ -152,20 +177,20 @@ class AmclParams:
     laser_z_short: float = 0.1
     laser_z_max: float = 0.05
     laser_z_rand: float = 0.05
-    laser_sigma_hit: float = 0.2
+    laser_sigma_hit: float = 0.1
     laser_lambda_short: float = 0.1
     laser_likelihood_max_dist: float = 2.0
-    laser_model_type: str = "likelihood_field"
+    laser_model_type: str = "likelihood_field_prob"
     do_beamskip: bool = False
     beam_skip_distance: float = 0.5
     beam_skip_threshold: float = 0.3
     beam_skip_error_threshold: float = 0.9
-    odom_model_type: str = "diff"
-    odom_alpha1: float = 0.2
-    odom_alpha2: float = 0.2
-    odom_alpha3: float = 0.2
-    odom_alpha4: float = 0.2
-    odom_alpha5: float = 0.2
+    odom_model_type: str = "diff-corrected"
+    odom_alpha1: float = MODEL_DEFAULT
+    odom_alpha2: float = MODEL_DEFAULT
+    odom_alpha3: float = MODEL_DEFAULT
+    odom_alpha4: float = MODEL_DEFAULT
+    odom_alpha5: float = MODEL_DEFAULT
     odom_frame_id: str = "odom"
     base_frame_id: str = "base_link"
     global_frame_id: str = "map"
@@ -212,7 +237,10 @@ class AmclParams:
             "beam_skip_error_threshold must be in [0, 1]",
         )
         for i in range(1, 6):
-            _check(getattr(self, f"odom_alpha{i}") >= 0.0, f"odom_alpha{i} must be >= 0")
+            name = f"odom_alpha{i}"
+            if getattr(self, name) == MODEL_DEFAULT:
+                object.__setattr__(self, name, ODOM_ALPHA_DEFAULTS[self.odom_model_type])
+            _check(getattr(self, name) >= 0.0, f"{name} must be >= 0 (or -1: the model's default)")
 
     @classmethod
     def from_ros(cls, params: Mapping[str, Any]) -> AmclParams:
@@ -243,6 +271,15 @@ class AmclParams:
             else:
                 kwargs[key] = value
         return cls(**kwargs)
+
+    @staticmethod
+    def default_of(name: str, odom_model_type: str) -> Any:
+        """The default of parameter ``name`` when ``odom_model_type`` is set (the alphas
+        depend on it; what a node declares)."""
+        field = next(f for f in dataclasses.fields(AmclParams) if f.name == name)
+        if field.default == MODEL_DEFAULT and name.startswith("odom_alpha"):
+            return ODOM_ALPHA_DEFAULTS.get(odom_model_type, MODEL_DEFAULT)
+        return field.default
 
     def to_ros(self) -> dict[str, Any]:
         """The parameters as a ``{ROS name: value}`` dict (what a node declares)."""

@@ -14,9 +14,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from roverlab.localization.amcl.clusters import cluster_stats, max_spread
 from roverlab.localization.amcl.errors import AmclInputError, AmclParamsError
 from roverlab.localization.amcl.field import AmclMap
-from roverlab.localization.amcl.kernels import cluster_stats, kld_resample
+from roverlab.localization.amcl.kernels import kld_resample
 
 __all__ = ["Clusters", "ParticleFilter", "kld_limits"]
 
@@ -218,18 +219,22 @@ class ParticleFilter:
         return int(self.poses.shape[0])
 
     # ------------------------------------------------------------------ measurement
-    def normalise(self, total: float) -> None:
+    def normalise(self, total: float, *, log_scale: float = 0.0, beams: int = 0) -> None:
         """After a sensor kernel multiplied the weights (their sum is ``total``):
         normalise, update the effective sample size and the likelihood averages.
 
         The averages follow Probabilistic Robotics' Augmented MCL over the mean measurement
-        likelihood ``sum(w_before * p)`` (``w_before`` summing to one; amcl divides it by
-        the particle count as well, which makes it jump whenever KLD sampling changes the
-        count). They are bias-corrected exponential averages: the plain mean of the
-        samples so far until there are ``1 / alpha`` of them (amcl starts them at the first
-        sample, so with ``alpha_slow`` 0.001 ``w_slow`` remembers the start-up for many
-        minutes). A zero or non-finite total makes the weights uniform and leaves the
-        averages alone.
+        likelihood ``sum(w_before * p) = total * exp(log_scale)`` (``w_before`` summing to
+        one; amcl divides it by the particle count as well, which makes it jump whenever
+        KLD sampling changes the count). With ``beams`` > 0 (a model whose ``p`` is a
+        product over the beams) they average its ``beams``-th root, the geometric mean
+        ``pz`` per beam: a product swings by orders of magnitude from scan to scan with
+        what the laser happens to see, so that a short average of it falls below a long
+        one (and random particles are injected) while the filter is right. They are
+        bias-corrected exponential averages: the plain mean of the samples so far until
+        there are ``1 / alpha`` of them (amcl starts them at the first sample, so with
+        ``alpha_slow`` 0.001 ``w_slow`` remembers the start-up for many minutes). A zero or
+        non-finite total makes the weights uniform and leaves the averages alone.
         """
         self._clusters = None
         n = self.count
@@ -237,7 +242,10 @@ class ParticleFilter:
             self.weights[:] = 1.0 / n
             self.n_effective = float(n)
             return
-        w_avg = total
+        if beams > 0:
+            w_avg = math.exp((math.log(total) + log_scale) / beams)
+        else:
+            w_avg = total * math.exp(log_scale)
         self.weights /= total
         self.n_effective = 1.0 / float(np.dot(self.weights, self.weights))
         self._samples += 1
@@ -283,9 +291,7 @@ class ParticleFilter:
         self._update_converged()
 
     def _update_converged(self) -> None:
-        centre = self.poses[:, :2].mean(axis=0)
-        spread = np.abs(self.poses[:, :2] - centre).max(initial=0.0)
-        self.converged = bool(spread <= CONVERGED_DISTANCE_M)
+        self.converged = bool(max_spread(self.poses) <= CONVERGED_DISTANCE_M)
 
     # ------------------------------------------------------------------ statistics
     def clusters(self) -> Clusters:

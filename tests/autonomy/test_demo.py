@@ -1,0 +1,148 @@
+"""``roverlab demo``, the main job: every stage of the seeds' story, its files, Ctrl-C, and
+the dashboard in a real browser while the robot explores."""
+
+from __future__ import annotations
+
+import json
+import signal
+import sys
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import pytest
+from PIL import Image
+from rosbags.highlevel import AnyReader
+
+from roverlab.maps import load_map
+from tests.helpers.procs import Proc
+from tests.viz.test_dashboard import CHROMIUM, CHROMIUM_ARGS, VIEWPORT
+
+DEMO = [sys.executable, "-m", "roverlab.cli", "demo", "--no-expose"]
+
+
+def _report(out: Path) -> dict:
+    return json.loads((out / "report.json").read_text())
+
+
+def _wait_exit(proc: Proc, timeout: float) -> int:
+    try:
+        return proc.popen.wait(timeout=timeout)
+    except Exception:
+        proc.stop()
+        raise
+
+
+def test_headless_demo_runs_every_stage_and_leaves_its_files(tmp_path: Path) -> None:
+    out = tmp_path / "demo"
+    proc = Proc([*DEMO, "--no-dashboard", "--rate", "max", "--places", "2", "--out", str(out)])
+    code = _wait_exit(proc, 600)
+    stdout = proc.rest()
+    assert code == 0, (stdout, proc.stop())
+    report = _report(out)
+    assert report["ok"] and report["stages"] == {
+        "explore": "ok", "save_map": "ok", "restart": "ok", "patrol": "ok"
+    }  # fmt: skip
+    assert report["coverage"] >= 0.95 and report["map_accuracy"] >= 0.95
+    assert report["patrol_goals"] == report["patrol_successes"] == 2
+    assert report["distance_m"] > 10.0
+    assert "patrol: 2/2 goals succeeded" in stdout and "Going to:" in stdout
+    # the map as map_saver writes it, loadable by map_server
+    saved = load_map(out / "map.yaml")
+    assert saved.info.resolution == pytest.approx(0.05)
+    for png in ("map.png", "coverage.png"):
+        with Image.open(out / png) as im:
+            assert im.size[0] >= 400
+    assert json.loads((out / "patrol.json").read_text())["successes"] == 2
+    # the recording has the whole story: the SLAM map, amcl and the move_base goals
+    with AnyReader([out / "run.mcap"]) as reader:
+        counts = {c.topic: c.msgcount for c in reader.connections}
+    for topic in ("/map", "/scan", "/tf", "/amcl_pose", "/move_base/goal", "/explore/frontiers"):
+        assert counts.get(topic, 0) > 0, (topic, sorted(counts))
+    assert not list(out.glob("*.part"))
+
+
+def test_ctrl_c_ends_the_demo_with_its_report_and_a_complete_recording(tmp_path: Path) -> None:
+    out = tmp_path / "demo"
+    proc = Proc([*DEMO, "--no-dashboard", "--rate", "2", "--out", str(out)])
+    proc.wait_line(lambda s: s.startswith("[explore] ..."), timeout=120)
+    time.sleep(3.0)
+    proc.popen.send_signal(signal.SIGINT)
+    code = _wait_exit(proc, 60)
+    assert code == 1
+    report = _report(out)
+    assert report["stages"]["explore"] == "interrupted"
+    assert report["stages"]["patrol"] == "skipped" and not report["ok"]
+    with AnyReader([out / "run.mcap"]) as reader:  # finished, not truncated
+        assert any(c.topic == "/scan" and c.msgcount > 0 for c in reader.connections)
+    assert not list(out.glob("*.part"))
+
+
+def test_bad_arguments_are_one_line() -> None:
+    proc = Proc([*DEMO, "--no-dashboard", "--places", "0"])
+    code = _wait_exit(proc, 60)
+    err = proc.stop()
+    assert code == 2 and err.strip().splitlines() == ["error: --places must be >= 1, got 0"]
+
+
+playwright_sync = pytest.importorskip("playwright.sync_api", reason="playwright not installed")
+
+
+def test_the_dashboard_shows_the_demo(tmp_path: Path) -> None:
+    """The dashboard's URL comes first; the page shows the map being built, the robot and
+    move_base's plan while it explores, the particle cloud while it patrols; the demo
+    reaches its report with every stage succeeding and keeps serving until Ctrl-C."""
+    if not CHROMIUM.exists():
+        pytest.skip("/usr/bin/chromium is absent (run scripts/install-system-deps.sh)")
+    out = tmp_path / "demo"
+    shots = tmp_path / "screenshots"
+    shots.mkdir()
+    proc = Proc([*DEMO, "--port", "0", "--rate", "5", "--places", "2", "--out", str(out)])
+    pw = playwright_sync.sync_playwright().start()
+    browser = pw.chromium.launch(executable_path=str(CHROMIUM), args=CHROMIUM_ARGS)
+    try:
+        first = proc.wait_line(timeout=120)
+        assert first.startswith("dashboard: http://127.0.0.1:"), first
+        url = first.split()[1]
+        page = browser.new_page(viewport=VIEWPORT)
+        errors: list[str] = []
+        page.on("pageerror", lambda e: errors.append(str(e)))
+        page.goto(url)
+        page.wait_for_function(
+            "() => window.viz && viz.data.map && viz.data.scan && viz.data.state"
+            " && viz.data.state.robot.length > 0 && viz.view.placed"
+            " && viz.data.layers.some(l => l && l.path && l.path.length > 1)"
+            " && viz.data.layers.some(l => l && l.markers && l.markers.length)",
+            timeout=120000,
+        )
+        page.wait_for_timeout(500)
+        page.screenshot(path=str(shots / "demo_exploring.png"))
+        seen: list[str] = []
+
+        def line(prefix: str) -> Callable[[str], bool]:
+            return lambda s: bool(seen.append(s)) or s.startswith(prefix)
+
+        proc.wait_line(line("[patrol] Going to:"), timeout=300)
+        page.wait_for_function(
+            "() => viz.data.layers.some(l => l && l.poses && l.poses.length > 10)",
+            timeout=60000,
+        )  # amcl's particle cloud
+        page.wait_for_timeout(1500)
+        page.screenshot(path=str(shots / "demo_patrolling.png"))
+        try:
+            proc.wait_line(line("the robot waits in the maze"), timeout=300)
+        except AssertionError as err:
+            raise AssertionError(f"{err}; stdout: {''.join(seen)}") from None
+        assert not errors, errors
+    finally:
+        browser.close()
+        pw.stop()
+        if proc.popen.poll() is None:
+            proc.popen.send_signal(signal.SIGINT)
+        code = _wait_exit(proc, 60)
+    report = _report(out)
+    assert report["ok"], report["stages"]
+    assert code == 0
+    for shot in ("demo_exploring.png", "demo_patrolling.png"):
+        with Image.open(shots / shot) as im:
+            assert im.size == (VIEWPORT["width"], VIEWPORT["height"])
