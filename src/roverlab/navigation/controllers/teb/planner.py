@@ -148,6 +148,12 @@ class TebPlanner:
         self._last_twist = Velocity2D()
         self._line_buf = np.empty((4096, 2), dtype=np.int64)
 
+    @property
+    def trajectory(self) -> NDArray[np.float64]:
+        """The optimised band's poses ``(N, 3)`` (what TebLocalPlannerROS publishes as
+        ``local_plan``); empty after a failed cycle."""
+        return self.band.poses
+
     # ------------------------------------------------------------------ plan / goal
     def set_plan(self, plan: ArrayLike) -> None:
         """A new global plan (the goal flag is reset; the band is kept for a warm start)."""
