@@ -97,6 +97,35 @@ def test_hector_map_is_sized_to_the_odometry_unless_set() -> None:
     assert hector_auto_size(log, given) is given
 
 
+def test_hector_grows_its_map_when_the_log_has_no_odometry() -> None:
+    # a log without odometry (a hand-held lidar): the first pass sees no motion, the
+    # default map (25.6 m) is too small for a 40 m corridor, and hector grows it
+    from roverlab.cli.slam_run import run_hector
+    from roverlab.geometry import SE2
+    from roverlab.raycast import Scene, cast_2d
+    from roverlab.slam.logs import LaserLog, ScanRecord
+
+    box = [[-2.0, -1.0, 42.0, -1.0], [-2.0, 1.0, 42.0, 1.0], [-2.0, -1.0, -2.0, 1.0],
+           [42.0, -1.0, 42.0, 1.0]]  # fmt: skip
+    walls = np.array(box + [[x, -1.0, x, -0.7] for x in range(0, 41, 3)])  # posts: features
+    scene = Scene(segments=walls)
+    beams = np.radians(np.linspace(-135.0, 135.0, 541))
+    rng = np.random.default_rng(1)
+    xs = np.arange(0.0, 40.0, 0.1)
+    recs = [
+        ScanRecord(timestamp=float(i), angle_min=float(beams[0]),
+                   angle_increment=float(beams[1] - beams[0]), range_min=0.0, range_max=30.0,
+                   ranges=(cast_2d(scene, x, 0.0, 0.5, beams, 30.0)
+                           + rng.normal(0.0, 0.01, beams.size)).astype(np.float32),
+                   odom_pose=SE2(0.0, 0.0, 0.0))
+        for i, x in enumerate(xs)
+    ]  # fmt: skip
+    res = run_hector(LaserLog(recs), {})
+    assert any("grown to 4096 cells" in n for n in res.notes), res.notes
+    end = np.asarray(res.poses)[-1]
+    assert end[0] == pytest.approx(xs[-1], abs=0.3) and abs(end[1]) < 0.25
+
+
 @pytest.mark.skipif(not (DATA / "intel.clf.bz2").is_file(), reason="shared/data/radish is absent")
 def test_graph_on_an_intel_slice_scores(tmp_path: Path) -> None:
     out = tmp_path / "g"

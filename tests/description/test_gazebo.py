@@ -245,6 +245,49 @@ def test_imu_noise_per_axis_sdf_form() -> None:
     assert (imu.accel.type, imu.accel.stddev) == ("gaussian", 0.017)
 
 
+def _lidar_noise(kind: str) -> str:
+    return with_gazebo(
+        '<gazebo reference="base"><sensor type="ray" name="l"><ray><scan><horizontal>'
+        "<samples>10</samples><min_angle>-1</min_angle><max_angle>1</max_angle></horizontal>"
+        "</scan><range><min>0.1</min><max>5</max></range>"
+        f"<noise><type>{kind}</type><stddev>0.05</stddev></noise></ray>"
+        '<plugin name="p" filename="libgazebo_ros_laser.so"><topicName>scan</topicName>'
+        "<frameName>base</frameName></plugin></sensor></gazebo>"
+    )
+
+
+@pytest.mark.parametrize(
+    ("kind", "stddev"), [("gaussian", 0.05), ("gaussian_quantized", 0.05), ("none", 0.0)]
+)
+def test_noise_types_gazebo_knows_and_what_the_simulator_adds(kind: str, stddev: float) -> None:
+    from roverlab.sim.robot import sim_config_from_model
+
+    m = load_robot(_lidar_noise(kind))
+    assert m.gazebo.sensor("l").ray.noise_type == kind  # type: ignore[union-attr]
+    (lidar,) = sim_config_from_model(m).lidars
+    assert lidar.params.noise_stddev == stddev
+
+
+def test_an_unknown_noise_type_is_refused_by_name() -> None:
+    with pytest.raises(URDFError, match=r"<noise/type>: unknown noise type 'gausian' \(one of"):
+        load_robot(_lidar_noise("gausian"))
+
+
+def test_imu_noise_of_type_none_adds_nothing() -> None:
+    from roverlab.sim.robot import sim_config_from_model
+
+    def imu(kind: str) -> str:  # mybot's form: the noise block inside the plugin
+        return with_gazebo(
+            '<gazebo><plugin name="i" filename="libgazebo_ros_imu.so"><bodyName>base</bodyName>'
+            f"<imu><noise><type>{kind}</type><rate><stddev>0.01</stddev></rate></noise></imu>"
+            "</plugin></gazebo>"
+        )
+
+    for kind, stddev in (("gaussian", 0.01), ("none", 0.0)):
+        (sensor,) = sim_config_from_model(load_robot(imu(kind))).imus
+        assert sensor.rate.stddev == stddev, kind
+
+
 def test_imu_plugin_frame_defaults_to_body_and_needs_a_body() -> None:
     m = load_robot(
         with_gazebo(

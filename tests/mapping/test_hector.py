@@ -504,6 +504,58 @@ def test_leaving_the_map_is_a_clear_error() -> None:
     assert slam.pose == SE2(1.0, 0.0, 0.0)  # the failed scan changed nothing
 
 
+def _occupied_world_points(grid: MultiResGrid, level: int) -> set[tuple[int, int]]:
+    """Occupied cells of ``level`` as world coordinates in millimetres."""
+    m = grid.occupancy(level)
+    iy, ix = np.nonzero(m.data == 100)
+    x = m.origin[0] + (ix + 0.5) * m.resolution
+    y = m.origin[1] + (iy + 0.5) * m.resolution
+    return set(zip(np.round(x * 1000).astype(int), np.round(y * 1000).astype(int), strict=True))
+
+
+def test_growing_the_grid_keeps_every_cell_where_it_is_in_the_world() -> None:
+    params = HectorParams(map_size=128, map_resolution=0.05, map_start_x=0.3, map_start_y=0.6)
+    grid = MultiResGrid(params)
+    rng = np.random.default_rng(3)
+    grid.update(np.array([0.5, -0.4, 0.3]), np.zeros(2), rng.uniform(-2.5, 2.5, (200, 2)))
+    before = [_occupied_world_points(grid, level) for level in range(3)]
+    probs = [grid.level_view(level).copy() for level in range(3)]
+    x0, y0, x1, y1 = grid.extent()
+    grid.grow()
+    assert list(grid.sizes) == [256, 128, 64]
+    assert [_occupied_world_points(grid, level) for level in range(3)] == before
+    assert all(before)  # the scan marked cells on every level
+    nx0, ny0, nx1, ny1 = grid.extent()
+    w, h = x1 - x0, y1 - y0
+    assert (nx0, ny0, nx1, ny1) == pytest.approx((x0 - w / 2, y0 - h / 2, x1 + w / 2, y1 + h / 2))
+    for level, old in enumerate(probs):  # the old square in the middle, unknown around it
+        n = old.shape[0]
+        new = grid.level_view(level)
+        np.testing.assert_array_equal(new[n // 2 : n // 2 + n, n // 2 : n // 2 + n], old)
+        assert np.count_nonzero(new != 0.5) == np.count_nonzero(old != 0.5)
+
+
+def test_a_growing_map_follows_the_robot_beyond_its_first_size() -> None:
+    rng = np.random.default_rng(6)
+    scene = _scene()
+    truth = _loop(360)
+    small = HectorParams(map_size=64, map_resolution=0.05)  # 3.2 m, the room is 10 m x 8 m
+    with pytest.raises(OutOfMapError, match="increase map_size"):
+        fixed = HectorSLAM(small)
+        for p in truth:
+            fixed.process(_scan(scene, p, rng), BEAMS)
+    rng = np.random.default_rng(6)
+    slam = HectorSLAM(small, grow_max_size=1024)
+    est = np.array([slam.process(_scan(scene, p, rng), BEAMS).as_array() for p in truth])
+    assert int(slam.grid.sizes[0]) == 512  # 25.6 m: holds the 10 m room seen from either end
+    err_xy, err_th = _pose_errors(est, _relative_to_first(truth))
+    assert err_xy.max() < 0.05 and err_th.max() < 0.015, (err_xy.max(), err_th.max())
+    capped = HectorSLAM(small, grow_max_size=128)
+    with pytest.raises(OutOfMapError, match="cannot grow beyond 128 cells"):
+        for p in truth:
+            capped.process(_scan(scene, p, rng), BEAMS)
+
+
 def test_input_errors() -> None:
     slam = HectorSLAM()
     with pytest.raises(HectorInputError, match="angles"):

@@ -660,3 +660,26 @@ def test_non_loopback_host_gets_a_token() -> None:
     assert server.token and len(server.token) >= 16
     assert f"token={server.token}" in server.url
     ctx.shutdown()
+
+
+def test_vendored_three_js_is_served_with_its_licence() -> None:
+    """three.js for the 3D view comes from the npm registry (pinned, scripts/vendor-three.sh)
+    and the dashboard serves it itself, licence included: no CDN."""
+    ctx = Context(clock="wall")
+    port = _free_port()
+    server = DashboardServer(ctx, "127.0.0.1", port)
+    ctx.spin_in_thread()
+    server.start()
+    try:
+        base = f"http://127.0.0.1:{port}/static/vendor/three"
+        with urllib.request.urlopen(f"{base}/three.module.min.js", timeout=5) as resp:
+            head = resp.read(400).decode()
+        assert "Copyright 2010-2024 Three.js Authors" in head and 'const t="170"' in head
+        with urllib.request.urlopen(f"{base}/LICENSE", timeout=5) as resp:
+            assert "The MIT License" in resp.read().decode()
+        with urllib.request.urlopen(f"{base}/VERSION", timeout=5) as resp:
+            assert resp.read().decode().startswith("three@0.170.0 (sha512-")
+        assert _http_status(f"{base}/addons/controls/OrbitControls.js") == 200
+    finally:
+        server.stop()
+        ctx.shutdown()

@@ -76,6 +76,13 @@ def test_2d_nav_goal_in_the_dashboard_drives_the_robot(nav: Nav, tmp_path: Path)
             timeout=30000,
         )
         assert _wait(lambda: nav.move_base.global_costmap.ready, 20.0)
+        # the Footprint (rviz/PolygonStamped) display draws the local costmap's footprint
+        assert not nav.server.bridge.config.unsupported
+        page.wait_for_function(
+            "() => viz.data.config.displays.some((d, i) => d.kind === 'polygon'"
+            " && viz.data.layers[i] && (viz.data.layers[i].markers || []).length === 1)",
+            timeout=20000,
+        )
         v = _view(page)
         gx, gy = -0.5, 0.4  # a free place of the maze
         px, py = _to_screen(v, gx, gy)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -28,6 +30,9 @@ ROOMS: dict[str, list[tuple[float, float]]] = {
     "office": [(-2.0, -2.0), (-2.0, 2.0), (6.0, -1.5), (4.5, 1.5), (6.6, 3.5), (8.3, 0.8)],
     "house": [(-2.5, 0.5), (4.5, -1.5), (-1.0, 3.0), (3.5, 3.0)],
     "empty": [(3.0, 3.0)],
+    # held out from exploration tuning (tests/world/make_held_out_worlds.py)
+    "warehouse": [(-1.0, 3.0), (5.0, -3.9), (5.0, -1.5), (5.5, 0.9), (9.0, 3.5), (11.5, -2.0)],
+    "apartment": [(-1.5, -2.5), (4.3, -1.0), (2.0, 2.1), (-1.0, 3.2), (2.5, 4.0), (5.5, 3.5)],
 }
 
 
@@ -135,6 +140,14 @@ def test_office_poster_faces_the_spawn() -> None:
     assert (y0, y1) == pytest.approx((0.5, -0.5))  # left to right as seen looking along +x
     assert scene.segment_z[textured[0]].tolist() == pytest.approx([0.2, 1.2])
     assert not w.footprint_collides(2.6, 0.0, 0.0, 0.2)  # a robot can drive up to it
+
+
+def test_held_out_worlds_are_their_generator_s_output(tmp_path: Path) -> None:
+    # written once by the script and never edited by hand (docs/exploration.md)
+    script = Path(__file__).with_name("make_held_out_worlds.py")
+    subprocess.run([sys.executable, str(script), str(tmp_path)], check=True, capture_output=True)
+    for name in ("warehouse", "apartment"):
+        assert (tmp_path / f"{name}.world").read_bytes() == bundled_world_path(name).read_bytes()
 
 
 def test_unknown_bundled_name() -> None:

@@ -155,7 +155,9 @@ def test_unknown_suffix_and_missing_file(tmp_path: Path) -> None:
         load_world(f)
     with pytest.raises(WorldError, match="not found"):
         load_world(tmp_path / "none.yaml")
-    with pytest.raises(WorldError, match="bundled worlds are empty, house, maze, office"):
+    with pytest.raises(
+        WorldError, match="bundled worlds are apartment, empty, house, maze, office, warehouse"
+    ):
         load_world("mze")
 
 

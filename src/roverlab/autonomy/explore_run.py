@@ -20,8 +20,8 @@ from typing import Any
 import numpy as np
 
 from roverlab.autonomy.monitor import RunMonitor
-from roverlab.autonomy.plots import write_line_chart
 from roverlab.autonomy.stack import ExploreStack, start_explore_stack
+from roverlab.charts import write_line_chart
 from roverlab.core import Context
 from roverlab.maps import save_map
 from roverlab.maps.plot import write_map_png

@@ -51,6 +51,7 @@ class RunMonitor(Node):
     Attributes:
         coverage: one :class:`CoverageSample` per map message.
         contacts: contact events seen (a step in contact after one that was not).
+        contact_events: when and where each began: ``(t, x, y, yaw)`` in the world.
     """
 
     def __init__(
@@ -73,6 +74,7 @@ class RunMonitor(Node):
         )  # fmt: skip
         self.coverage: list[CoverageSample] = []
         self.contacts = 0
+        self.contact_events: list[tuple[float, float, float, float]] = []
         self.map_msg: Any = None
         self._reachable: dict[float, ReachableArea] = {}
         self._path = _Path()
@@ -87,10 +89,12 @@ class RunMonitor(Node):
         sim = self.simulation.simulator
         sim.advance()
         contact = sim.contact
+        t = self.get_clock().now_ns() / 1e9
         if contact and not self._in_contact:
             self.contacts += 1
+            self.contact_events.append((t, sim.x, sim.y, sim.yaw))
         self._in_contact = contact
-        self._path.t.append(self.get_clock().now_ns() / 1e9)
+        self._path.t.append(t)
         self._path.xy.append((sim.x, sim.y, sim.yaw))
 
     def reachable(self, resolution: float) -> ReachableArea:

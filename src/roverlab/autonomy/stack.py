@@ -20,6 +20,8 @@ from roverlab.description import find_package
 from roverlab.errors import RoverlabError
 from roverlab.launch import Launch, build_launch
 from roverlab.launch.xml import LaunchSpec, load_launch
+from roverlab.navigation.costmap.footprint import footprint_radii, pad_footprint
+from roverlab.navigation.costmap.inflation_layer import compute_cost
 from roverlab.navigation.explore.node import Explore
 from roverlab.navigation.move_base.node import MoveBase
 from roverlab.sim.app import Simulation
@@ -48,6 +50,7 @@ SLAM_METHODS = tuple(SLAM_NODES)
 _PARAMS_ROBOT = "mybot"
 _INFLATION_M = 0.45  # NanoRobot's inflation_radius
 _FOOTPRINT_PADDING_M = 0.01
+_COST_SCALING = 6.0  # NanoRobot's cost_scaling_factor
 
 
 class AutonomyError(RoverlabError):
@@ -72,12 +75,16 @@ class ExploreStack:
 
 
 def footprint_params(footprint: np.ndarray, inflation_m: float = _INFLATION_M) -> dict[str, Any]:
-    """Both costmaps' ``footprint`` (the outline, padded in the costmap) and an inflation
-    radius that covers the robot's circumscribed radius plus a margin."""
+    """Both costmaps' ``footprint`` (the outline, padded in the costmap), an inflation
+    radius that covers the robot's circumscribed radius plus a margin, and the global
+    planner's ``lethal_cost`` at that circumscribed radius (as explore_planner_params.yaml
+    for mybot: plans only where the robot can turn in place)."""
     outline = [[round(float(x), 3), round(float(y), 3)] for x, y in footprint]
-    circumscribed = float(np.max(np.hypot(footprint[:, 0], footprint[:, 1])))
+    padded = pad_footprint(np.asarray(outline), _FOOTPRINT_PADDING_M)
+    inscribed, circumscribed = footprint_radii(padded)
     inflation = max(inflation_m, circumscribed + 0.2)
-    out: dict[str, Any] = {}
+    at_circumscribed = compute_cost(circumscribed, 1.0, inscribed, _COST_SCALING)
+    out: dict[str, Any] = {"GlobalPlanner/lethal_cost": min(253, at_circumscribed + 2)}
     for costmap in ("global_costmap", "local_costmap"):
         out[f"{costmap}/footprint"] = outline
         out[f"{costmap}/inflation_layer/inflation_radius"] = inflation

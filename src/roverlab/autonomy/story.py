@@ -26,13 +26,13 @@ from typing import Any, TypeVar
 import numpy as np
 
 from roverlab.autonomy.monitor import RunMonitor
-from roverlab.autonomy.plots import write_line_chart
 from roverlab.autonomy.stack import (
     AutonomyError,
     ExploreStack,
     set_node_params,
     start_explore_stack,
 )
+from roverlab.charts import write_line_chart
 from roverlab.core import Context, Time
 from roverlab.description import find_package
 from roverlab.launch import Launch, build_launch

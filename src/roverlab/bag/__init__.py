@@ -1,5 +1,5 @@
 """Recording and playing back topics (rosbag / ros2 bag)."""
 
-from roverlab.bag.recorder import McapRecorder
+from roverlab.bag.recorder import BagError, McapRecorder
 
-__all__ = ["McapRecorder"]
+__all__ = ["BagError", "McapRecorder"]

@@ -7,7 +7,7 @@ import math
 import signal
 import threading
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -105,16 +105,25 @@ def network_options(ctx: typer.Context) -> NetworkOptions:
 
 
 @contextlib.contextmanager
-def stop_on_signals(stop: threading.Event) -> Iterator[threading.Event]:
-    """Inside the block SIGINT, SIGTERM and SIGHUP set ``stop`` (the command then finishes
-    its output files and returns) instead of killing the process; the old handlers come
-    back at the end. A second SIGINT interrupts (KeyboardInterrupt)."""
+def stop_on_signals(
+    stop: threading.Event, on_stop: Callable[[], None] | None = None
+) -> Iterator[threading.Event]:
+    """Inside the block SIGINT, SIGTERM and SIGHUP set ``stop`` (and call ``on_stop``, e.g.
+    an executor's ``stop``: the command then finishes its output files and returns) instead
+    of killing the process; the old handlers come back at the end. A second SIGINT
+    interrupts (KeyboardInterrupt). Off the main thread (where Python cannot install signal
+    handlers) the block runs unchanged."""
 
     def on_signal(signum: int, _frame: Any) -> None:
         if signum == signal.SIGINT and stop.is_set():
             raise KeyboardInterrupt
         stop.set()
+        if on_stop is not None:
+            on_stop()
 
+    if threading.current_thread() is not threading.main_thread():
+        yield stop
+        return
     sigs = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
     old = {s: signal.signal(s, on_signal) for s in sigs}
     try:
@@ -125,14 +134,16 @@ def stop_on_signals(stop: threading.Event) -> Iterator[threading.Event]:
 
 
 def run_context(context: Context, duration_s: float | None) -> float:
-    """Spin until ``duration_s`` of clock time (or forever), Ctrl-C, or shutdown; then
-    shut the context down. Returns the wall seconds it ran."""
+    """Spin until ``duration_s`` of clock time (or forever), SIGINT / SIGTERM / SIGHUP, or
+    shutdown; then shut the context down (which finishes recordings). Returns the wall
+    seconds it ran."""
     started = time.monotonic()
     try:
-        if duration_s is None:
-            context.spin()
-        else:
-            context.spin_for(duration_s)
+        with stop_on_signals(threading.Event(), context.executor.stop):
+            if duration_s is None:
+                context.spin()
+            else:
+                context.spin_for(duration_s)
     except KeyboardInterrupt:
         pass
     finally:

@@ -9,8 +9,10 @@ from typing import Annotated
 
 import typer
 
+from roverlab.autonomy.explore_batch import PLOT_COLUMNS, explore_episode
 from roverlab.autonomy.explore_run import run_explore, write_explore_outputs
 from roverlab.autonomy.stack import SLAM_METHODS, AutonomyError
+from roverlab.cli.batch import run_episodes
 from roverlab.cli.common import stop_on_signals
 from roverlab.cli.sim import parse_rate
 from roverlab.core import configure_logging
@@ -45,6 +47,30 @@ def explore(
     x: Annotated[float, typer.Option("-x", help="Spawn x (m).")] = 0.0,
     y: Annotated[float, typer.Option("-y", help="Spawn y (m).")] = 0.0,
     yaw: Annotated[float, typer.Option("-Y", "--yaw", help="Spawn yaw (rad).")] = 0.0,
+    episodes: Annotated[
+        int,
+        typer.Option(
+            "--episodes",
+            help="Run this many episodes; episode i uses seed SEED+i. More than one writes "
+            "OUT/episodes.json, episodes.csv, episodes.png and OUT/episode_NNN/.",
+        ),
+    ] = 1,
+    workers: Annotated[
+        int,
+        typer.Option(
+            "--workers",
+            help="Episodes run in parallel on this many CPUs (a local Ray instance; "
+            "needs the 'ray' extra). 1: one after the other, no Ray.",
+        ),
+    ] = 1,
+    ray_address: Annotated[
+        str | None,
+        typer.Option(
+            "--ray-address",
+            help="Run the episodes on this running Ray cluster (e.g. ray://head:10001 or "
+            "auto); see docs/scale.md.",
+        ),
+    ] = None,
 ) -> None:
     """Explore a world with explore_lite + move_base + a SLAM node, then score the map.
 
@@ -57,8 +83,23 @@ def explore(
         raise AutonomyError(f"unknown --slam {slam!r} (one of {', '.join(SLAM_METHODS)})")
     if not (duration > 0 and math.isfinite(duration)):
         raise AutonomyError(f"--duration must be a positive number of seconds, got {duration}")
+    if out.exists() and not out.is_dir():
+        raise AutonomyError(f"--out {out}: not a folder")
     pace = parse_rate(rate)
     configure_logging()
+    if episodes != 1 or workers != 1 or ray_address is not None:
+        if not math.isinf(pace):
+            raise AutonomyError("--episodes/--workers run at --rate max only")
+        config = {
+            "world": world, "robot": robot, "slam": slam, "duration_s": duration,
+            "spawn": [x, y, yaw],
+        }  # fmt: skip
+        run_episodes(
+            explore_episode, config, episodes=episodes, seed=seed, workers=workers,
+            address=ray_address, out=out, plot=PLOT_COLUMNS,
+            title=f"explore {Path(world).stem} / {slam}: {episodes} episodes",
+        )  # fmt: skip
+        return
     with stop_on_signals(threading.Event()) as stop:
         episode = run_explore(
             world=world, robot=robot, slam=slam, seed=seed, duration_s=duration, rate=pace,

@@ -125,6 +125,7 @@ def launch(
         typer.echo(f"warning: {warning}", err=True)
     names = ", ".join(n.get_fully_qualified_name() for n in started.nodes)
     typer.echo(f"started {len(started.nodes)} nodes: {names}", err=True)
+    started.supervise()
     wall = run_context(context, duration)
     typer.echo(
         f"launch stopped after {context.now().seconds:.1f} sim s ({wall:.1f} s wall)", err=True

@@ -7,6 +7,7 @@ from typing import Annotated
 
 import typer
 
+from roverlab.bag import cli as bag_cli
 from roverlab.cli import (
     action,
     amcl_run,
@@ -28,6 +29,7 @@ from roverlab.cli import (
 from roverlab.cli.common import NetworkOptions
 from roverlab.description import cli as urdf_cli
 from roverlab.errors import RoverlabError
+from roverlab.foxglove import cli as foxglove_cli
 from roverlab.maps import cli as map_cli
 from roverlab.slam import cli as slam_cli
 from roverlab.teleop import cli as teleop_cli
@@ -65,6 +67,8 @@ app.add_typer(slam_cli.app, name="slam")
 app.command("teleop")(teleop_cli.teleop)
 app.add_typer(amcl_run.app, name="amcl")
 app.add_typer(nav.app, name="nav")
+app.add_typer(bag_cli.app, name="bag")
+app.command("foxglove")(foxglove_cli.foxglove)
 
 
 @app.callback()

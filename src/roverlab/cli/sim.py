@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import math
+import threading
 from pathlib import Path
 from typing import Annotated
 
 import typer
 
 from roverlab.bag import McapRecorder
-from roverlab.cli.common import choose_expose, network_options, run_context
+from roverlab.cli.common import choose_expose, network_options, run_context, stop_on_signals
 from roverlab.core import Context, configure_logging
 from roverlab.core.transport.zenoh import ZenohTransport
 from roverlab.sim.app import Simulation, SimulationError
@@ -105,6 +106,43 @@ def sim(
     context = Context(
         clock="sim" if math.isinf(pace) else "paced", rate=1.0 if math.isinf(pace) else pace
     )
+    # a signal while the world loads stops the run before it starts; the file is still finished
+    with stop_on_signals(threading.Event(), context.executor.stop):
+        _run(
+            ctx,
+            context,
+            record=record,
+            world=world,
+            robot=robot,
+            spawn=SpawnPose(x, y, yaw),
+            seed=seed,
+            args=parse_args(arg),
+            expose=expose,
+            pace=pace,
+            rate=rate,
+            dashboard=dashboard,
+            dashboard_port=dashboard_port,
+            duration=duration,
+        )
+
+
+def _run(
+    ctx: typer.Context,
+    context: Context,
+    *,
+    record: Path | None,
+    world: str,
+    robot: str,
+    spawn: SpawnPose,
+    seed: int,
+    args: dict[str, str],
+    expose: bool | None,
+    pace: float,
+    rate: str,
+    dashboard: bool,
+    dashboard_port: int,
+    duration: float | None,
+) -> None:
     recorder: McapRecorder | None = None
     try:
         if record is not None:
@@ -114,9 +152,9 @@ def sim(
             context=context,
             world=world,
             robot=robot,
-            spawn=SpawnPose(x, y, yaw),
+            spawn=spawn,
             seed=seed,
-            robot_args=parse_args(arg),
+            robot_args=args,
         )
         if choose_expose(expose, pace):
             context.add_transport(ZenohTransport(network_options(ctx).zenoh_options()))

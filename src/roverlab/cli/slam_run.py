@@ -37,6 +37,7 @@ METHODS = ("hector", "gmapping", "graph")
 # much (m) plus a share of the box (odometry drifts, so the true path is not inside it)
 _HECTOR_MARGIN_M = 5.0
 _HECTOR_MARGIN_SHARE = 0.15
+_HECTOR_GROW_MAX = 8192  # cells per side: 1 GB for three levels
 
 
 def run_graph(records: LaserLog, params: dict[str, object]) -> MethodResult:
@@ -99,7 +100,11 @@ def run_hector(records: LaserLog, params: dict[str, object]) -> MethodResult:
             f"({hp.map_size * hp.map_resolution:.1f} m), map_start_x {hp.map_start_x:.3f}, "
             f"map_start_y {hp.map_start_y:.3f}"
         )
-    result = HectorSLAM(hp).run_log(progress(records, "hector"))
+    # the odometry's box can be wrong (drift, a log without odometry): grow rather than fail
+    slam = HectorSLAM(hp, grow_max_size=max(hp.map_size, _HECTOR_GROW_MAX))
+    result = slam.run_log(progress(records, "hector"))
+    if int(slam.grid.sizes[0]) != hp.map_size:
+        notes.append(f"hector map grown to {int(slam.grid.sizes[0])} cells per side")
     m = result.map
     return MethodResult(m.data, m.resolution, m.origin, result.poses, result.trajectory, notes)
 

@@ -264,6 +264,10 @@ class Context:
         thread.start()
         return thread
 
+    def is_shutdown(self) -> bool:
+        """Whether :meth:`shutdown` was called."""
+        return self._closed
+
     def shutdown(self) -> None:
         """Stop spinning, destroy the nodes and close the transports."""
         if self._closed:

@@ -395,6 +395,10 @@ class Node:
         if timer in self.timers:
             self.timers.remove(timer)
 
+    def is_destroyed(self) -> bool:
+        """Whether :meth:`destroy_node` was called (by the node itself or its context)."""
+        return self._destroyed
+
     def destroy_node(self) -> None:
         if self._destroyed:
             return

@@ -133,6 +133,9 @@ def resolve_frame(namespace: str, frame: str) -> str:
 
 
 # --------------------------------------------------------------------------- specs
+NOISE_TYPES = ("none", "gaussian", "gaussian_quantized")
+
+
 @dataclass(frozen=True, slots=True)
 class NoiseSpec:
     """SDF ``<noise>``: type (``none``/``gaussian``), mean, stddev, and bias for IMUs."""
@@ -487,6 +490,14 @@ class _Values:
         value = self.values.get(key)
         return default if value is None else value.strip()
 
+    def noise_type(self, key: str) -> str:
+        """A ``<noise><type>``: Gazebo's ``none``, ``gaussian`` or ``gaussian_quantized``
+        (Gazebo prints an error and adds no noise for any other; roverlab refuses it)."""
+        value = self.text(key, "none")
+        if value not in NOISE_TYPES:
+            raise self.fail(key, f"unknown noise type '{value}' (one of {', '.join(NOISE_TYPES)})")
+        return value
+
     def number(self, key: str, default: float) -> float:
         raw = self.values.get(key)
         if raw is None or not raw.strip():
@@ -559,7 +570,7 @@ def _flatten(elem: ET.Element, prefix: str = "") -> dict[str, str]:
 
 def _noise(values: _Values, prefix: str) -> NoiseSpec:
     return NoiseSpec(
-        type=values.text(prefix + "type", "none"),
+        type=values.noise_type(prefix + "type"),
         mean=values.number(prefix + "mean", 0.0),
         stddev=values.non_negative(prefix + "stddev", 0.0),
         bias_mean=values.number(prefix + "bias_mean", 0.0),
@@ -575,7 +586,7 @@ def _imu_noise(elem: ET.Element | None, where: str) -> ImuSpec | None:
     v = _Values(_flatten(elem), where + ": <imu>")
     keys = v.values.keys()
     if any(k.startswith("noise/") for k in keys):
-        noise_type = v.text("noise/type", "none")
+        noise_type = v.noise_type("noise/type")
         return ImuSpec(
             rate=replace(_noise(v, "noise/rate/"), type=noise_type),
             accel=replace(_noise(v, "noise/accel/"), type=noise_type),
@@ -586,8 +597,9 @@ def _imu_noise(elem: ET.Element | None, where: str) -> ImuSpec | None:
     def axis(noise: ET.Element | None, what: str) -> NoiseSpec:
         if noise is None:
             return NoiseSpec()
-        spec = _noise(_Values(_flatten(noise), f"{where}: <imu> {what}"), "")
-        return replace(spec, type=noise.get("type", spec.type))
+        values = _Values({**_flatten(noise), "type": noise.get("type", "none")},
+                         f"{where}: <imu> {what}")  # fmt: skip
+        return _noise(values, "")
 
     return ImuSpec(rate=axis(av, "angular_velocity"), accel=axis(la, "linear_acceleration"))
 
@@ -624,7 +636,7 @@ def _ray(elem: ET.Element, where: str) -> RaySpec:
         range_resolution=v.non_negative("range/resolution", 0.0),
         noise_mean=v.number("noise/mean", 0.0),
         noise_stddev=v.non_negative("noise/stddev", 0.0),
-        noise_type=v.text("noise/type", "none"),
+        noise_type=v.noise_type("noise/type"),
         vertical=vertical,
     )
     if spec.max_angle < spec.min_angle:
@@ -645,7 +657,7 @@ def _camera(elem: ET.Element, where: str) -> CameraSpec:
         clip_far=v.non_negative("clip/far", 100.0),
         noise_mean=v.number("noise/mean", 0.0),
         noise_stddev=v.non_negative("noise/stddev", 0.0),
-        noise_type=v.text("noise/type", "none"),
+        noise_type=v.noise_type("noise/type"),
         name=elem.get("name", ""),
     )
     if not 0.0 < spec.horizontal_fov < math.pi:

@@ -2,18 +2,40 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+import contextlib
+import os
+import sys
+import threading
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 
 from roverlab.core import Context, Node, QoSProfile
+from roverlab.core.log import log_to_file
 from roverlab.launch.registry import REGISTRY, LaunchState
-from roverlab.launch.xml import LaunchError, LaunchSpec, load_launch
+from roverlab.launch.xml import LaunchError, LaunchSpec, NodeSpec, load_launch
 from roverlab.msgs import classes as mc
 from roverlab.sim.node import SimulatorNode, SpawnPose
 from roverlab.sim.robot import sim_config_from_model
 
 __all__ = ["Launch", "build_launch"]
+
+
+@contextlib.contextmanager
+def _environment(env: Mapping[str, str]) -> Iterator[None]:
+    """``env`` set in os.environ while a node is created (its ``<env>`` scope), then the
+    process's own values back."""
+    saved = {k: os.environ.get(k) for k in env}
+    os.environ.update(env)
+    try:
+        yield
+    finally:
+        for k, v in saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
 
 
 @dataclass
@@ -25,6 +47,98 @@ class Launch:
     nodes: list[Node] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
     simulator: SimulatorNode | None = None
+    state: LaunchState | None = None
+    # what roslaunch does for a process: which node runs each <node>, and how it ended
+    running: dict[str, tuple[NodeSpec, Node]] = field(default_factory=dict)
+    deaths: list[str] = field(default_factory=list)
+    _watch: threading.Thread | None = None
+
+    def start_node(self, node_spec: NodeSpec) -> Node | None:
+        """Create one ``<node>``; a node that fails to start has died (roslaunch's
+        "process has died"): respawned after ``respawn_delay``, the launch shut down when
+        it is ``required``, otherwise reported while the others go on."""
+        assert self.state is not None
+        factory = REGISTRY.get((node_spec.pkg, node_spec.type))
+        if factory is None:
+            self.state.warnings.append(
+                f"{node_spec.source}: node {node_spec.pkg}/{node_spec.type} is not part of "
+                "roverlab; skipped"
+            )
+            return None
+        before = set(self.context.nodes)
+        try:
+            with _environment(node_spec.env):
+                node = factory(self.state, node_spec)
+        except LaunchError:
+            raise
+        except Exception as err:  # the node's failure, in one line
+            for name in set(self.context.nodes) - before:  # what it left half made
+                self.context.nodes[name].destroy_node()
+            self.died(node_spec, f"{type(err).__name__}: {err}".splitlines()[0])
+            return None
+        if node is None:
+            return None
+        unused = node.unused_parameter_overrides()
+        if unused:
+            self.state.warnings.append(
+                f"{node_spec.source}: parameters not used by roverlab's "
+                f"{node_spec.pkg}/{node_spec.type}: {', '.join(sorted(unused))}"
+            )
+            node.discard_parameter_overrides(unused)
+        if node_spec.output == "log":
+            log_dir = Path(os.environ.get("ROVERLAB_LOG_DIR", Path.home() / ".roverlab" / "log"))
+            log_to_file(node.get_fully_qualified_name(), log_dir / f"{node_spec.name}.log")
+        self.nodes.append(node)
+        self.running[node_spec.fq_name] = (node_spec, node)
+        return node
+
+    def died(self, node_spec: NodeSpec, reason: str) -> None:
+        """roslaunch's handling of a process that ended: respawn, shut down, or report."""
+        name = node_spec.fq_name
+        self.running.pop(name, None)
+        if node_spec.required:
+            self.deaths.append(f"REQUIRED process [{name}] has died: {reason}; shutting down")
+            print(f"[ERROR] {self.deaths[-1]}", file=sys.stderr, flush=True)
+            self.context.shutdown()
+            return
+        if node_spec.respawn:
+            self.deaths.append(
+                f"process [{name}] has died: {reason}; respawning in {node_spec.respawn_delay:g} s"
+            )
+            print(f"[WARN] {self.deaths[-1]}", file=sys.stderr, flush=True)
+            timer = threading.Timer(
+                node_spec.respawn_delay,
+                self.context.executor.call_soon_threadsafe,
+                (partial(self._respawn, node_spec),),
+            )
+            timer.daemon = True
+            timer.start()
+            return
+        self.deaths.append(f"process [{name}] has died: {reason}")
+        print(f"[ERROR] {self.deaths[-1]}", file=sys.stderr, flush=True)
+
+    def _respawn(self, node_spec: NodeSpec) -> None:
+        if not self.context.is_shutdown():
+            self.start_node(node_spec)
+
+    def supervise(self, period_s: float = 0.5) -> None:
+        """Watch the nodes (wall clock) for ones that end themselves (``destroy_node``:
+        a script that returned, ``rospy.signal_shutdown``) and treat them as dead."""
+
+        def watch() -> None:
+            stop = threading.Event()
+            while not self.context.is_shutdown() and not stop.wait(period_s):
+                for spec_node in list(self.running.values()):
+                    node_spec, node = spec_node
+                    if node.is_destroyed() and node_spec.fq_name in self.running:
+                        self.context.executor.call_soon_threadsafe(partial(self._ended, node_spec))
+
+        self._watch = threading.Thread(target=watch, name="roslaunch-watch", daemon=True)
+        self._watch.start()
+
+    def _ended(self, node_spec: NodeSpec) -> None:
+        if node_spec.fq_name in self.running and not self.context.is_shutdown():
+            self.died(node_spec, "it ended")
 
 
 def build_launch(
@@ -46,25 +160,11 @@ def build_launch(
     """
     spec = path if isinstance(path, LaunchSpec) else load_launch(path, args)
     state = LaunchState(context=context, params=spec.params)
-    launch = Launch(context=context, spec=spec)
+    launch = Launch(context=context, spec=spec, state=state)
     for node_spec in spec.nodes:
-        factory = REGISTRY.get((node_spec.pkg, node_spec.type))
-        if factory is None:
-            state.warnings.append(
-                f"{node_spec.source}: node {node_spec.pkg}/{node_spec.type} is not part of "
-                "roverlab; skipped"
-            )
-            continue
-        node = factory(state, node_spec)
-        if node is not None:
-            unused = node.unused_parameter_overrides()
-            if unused:
-                state.warnings.append(
-                    f"{node_spec.source}: parameters not used by roverlab's "
-                    f"{node_spec.pkg}/{node_spec.type}: {', '.join(sorted(unused))}"
-                )
-                node.discard_parameter_overrides(unused)
-            launch.nodes.append(node)
+        launch.start_node(node_spec)
+        if context.is_shutdown():  # a required node failed to start
+            raise LaunchError(launch.deaths[-1])
     if state.spawns:
         if state.world is None:
             raise LaunchError(f"{state.spawns[0][2]}: spawn_model without a Gazebo world")

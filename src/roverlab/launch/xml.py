@@ -49,6 +49,11 @@ class NodeSpec:
     params: dict[str, Any] = field(default_factory=dict)
     remaps: dict[str, str] = field(default_factory=dict)
     source: str = ""
+    output: str = "log"  # roslaunch's default: INFO to the node's log file, WARN+ to screen
+    respawn: bool = False
+    respawn_delay: float = 0.0  # wall seconds
+    required: bool = False
+    env: dict[str, str] = field(default_factory=dict)  # <env> of its scope
 
     @property
     def fq_name(self) -> str:
@@ -72,11 +77,19 @@ _FALSE = {"false", "0"}
 class _Scope:
     """Arguments and namespace of one file (or group)."""
 
-    def __init__(self, path: Path, args: dict[str, str], ns: str, remaps: dict[str, str]) -> None:
+    def __init__(
+        self,
+        path: Path,
+        args: dict[str, str],
+        ns: str,
+        remaps: dict[str, str],
+        env: dict[str, str] | None = None,
+    ) -> None:
         self.path = path
         self.args = args
         self.ns = ns
         self.remaps = remaps
+        self.env = dict(env or {})  # <env> of this scope: for the nodes declared after it
         self.anon: dict[str, str] = {}
 
 
@@ -182,6 +195,7 @@ class _Reader:
         args: Mapping[str, str],
         ns: str = "/",
         remaps: dict[str, str] | None = None,
+        env: dict[str, str] | None = None,
     ) -> None:
         self.spec.files.append(path)
         try:
@@ -192,7 +206,7 @@ class _Reader:
             raise LaunchError(f"{path}: cannot read: {err.strerror}") from err
         if root.tag != "launch":
             raise LaunchError(f"{path}: the root element must be <launch>, not <{root.tag}>")
-        scope = _Scope(path, dict(args), ns, dict(remaps or {}))
+        scope = _Scope(path, dict(args), ns, dict(remaps or {}), env)
         self.children(root, scope, passed=set(args))
 
     def children(self, parent: ET.Element, scope: _Scope, passed: set[str]) -> None:
@@ -287,7 +301,9 @@ class _Reader:
             args=self.attr(elem, "args", scope, ""),
             remaps=dict(scope.remaps),
             source=_where(scope, elem),
+            env=dict(scope.env),
         )
+        self.on_process_attrs(elem, scope, node)
         for child in elem:
             if not isinstance(child.tag, str) or not self.enabled(child, scope):
                 continue
@@ -298,11 +314,34 @@ class _Reader:
             elif child.tag == "remap":
                 node.remaps[self.attr(child, "from", scope)] = self.attr(child, "to", scope)
             elif child.tag == "env":
-                self.on_env(child, scope, passed)
+                self.env_into(child, scope, node.env)
             else:
                 raise LaunchError(f"{_where(scope, child)}: not allowed inside <node>")
         node.params = {k.lstrip("/"): v for k, v in node.params.items()}
         self.spec.nodes.append(node)
+
+    def on_process_attrs(self, elem: ET.Element, scope: _Scope, node: NodeSpec) -> None:
+        """roslaunch's process attributes: output, respawn, respawn_delay, required."""
+        where = _where(scope, elem)
+        node.output = self.attr(elem, "output", scope, "log")
+        if node.output not in ("log", "screen"):
+            raise LaunchError(f"{where}: output must be 'log' or 'screen', not {node.output!r}")
+        flags = {}
+        for name in ("respawn", "required"):
+            text = self.attr(elem, name, scope, "false").strip().lower()
+            if text not in ("true", "false"):
+                raise LaunchError(f"{where}: {name} must be true or false, not {text!r}")
+            flags[name] = text == "true"
+        node.respawn, node.required = flags["respawn"], flags["required"]
+        if node.respawn and node.required:
+            raise LaunchError(f"{where}: respawn and required cannot both be true")
+        delay = self.attr(elem, "respawn_delay", scope, "0")
+        try:
+            node.respawn_delay = float(delay)
+        except ValueError:
+            raise LaunchError(f"{where}: respawn_delay must be a number, not {delay!r}") from None
+        if not (node.respawn_delay >= 0.0 and node.respawn_delay < float("inf")):
+            raise LaunchError(f"{where}: respawn_delay must be >= 0 seconds, not {delay}")
 
     def on_include(self, elem: ET.Element, scope: _Scope, passed: set[str]) -> None:
         path = Path(self.attr(elem, "file", scope))
@@ -310,6 +349,7 @@ class _Reader:
             path = scope.path.parent / path
         ns = _join(scope.ns, self.attr(elem, "ns", scope, "")) if elem.get("ns") else scope.ns
         args: dict[str, str] = {}
+        env = dict(scope.env)
         for child in elem:
             if not isinstance(child.tag, str) or not self.enabled(child, scope):
                 continue
@@ -320,18 +360,18 @@ class _Reader:
                 elif "default" in child.attrib:
                     args[name] = self.attr(child, "default", scope)
             elif child.tag == "env":
-                self.on_env(child, scope, passed)
+                self.env_into(child, scope, env)
             else:
                 raise LaunchError(f"{_where(scope, child)}: not allowed inside <include>")
         if elem.get("pass_all_args", "false").lower() == "true":
             args = {**scope.args, **args}
         if not path.is_file():
             raise LaunchError(f"{_where(scope, elem)}: included file {path} does not exist")
-        self.read_file(path, args, ns or "/", scope.remaps)
+        self.read_file(path, args, ns or "/", scope.remaps, env)
 
     def on_group(self, elem: ET.Element, scope: _Scope, passed: set[str]) -> None:
         ns = _join(scope.ns, self.attr(elem, "ns", scope, "")) if elem.get("ns") else scope.ns
-        inner = _Scope(scope.path, scope.args, ns or "/", dict(scope.remaps))
+        inner = _Scope(scope.path, scope.args, ns or "/", dict(scope.remaps), scope.env)
         inner.anon = scope.anon
         self.children(elem, inner, passed)
 
@@ -339,7 +379,12 @@ class _Reader:
         scope.remaps[self.attr(elem, "from", scope)] = self.attr(elem, "to", scope)
 
     def on_env(self, elem: ET.Element, scope: _Scope, passed: set[str]) -> None:
-        os.environ[self.attr(elem, "name", scope)] = self.attr(elem, "value", scope)
+        self.env_into(elem, scope, scope.env)
+
+    def env_into(self, elem: ET.Element, scope: _Scope, env: dict[str, str]) -> None:
+        """``<env>``: set for the nodes of its scope (roslaunch gives it to their
+        processes; roverlab sets it while such a node is created), not for the launch."""
+        env[self.attr(elem, "name", scope)] = self.attr(elem, "value", scope)
 
     # ------------------------------------------------------------- helpers
     def _read_text(self, path: Path, scope: _Scope, elem: ET.Element) -> str:

@@ -398,9 +398,12 @@ def load_map(path: str | os.PathLike[str]) -> OccupancyMap:
         MapError: a bad YAML file or a missing or unreadable image.
     """
     info = read_map_yaml(path)
-    pixels, has_alpha = read_image_pixels(info.image)
-    if pixels.shape[0] == 0 or pixels.shape[1] == 0:
-        raise MapError(f"{info.image}: empty image")
+    try:
+        pixels, has_alpha = read_image_pixels(info.image)
+        if pixels.shape[0] == 0 or pixels.shape[1] == 0:
+            raise MapError(f"{info.image}: empty image")
+    except MapError as err:  # name the YAML file that points at the image too
+        raise MapError(f"{path}: image {err}") from err
     data = image_to_occupancy(
         pixels,
         has_alpha=has_alpha,

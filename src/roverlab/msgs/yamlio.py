@@ -12,6 +12,8 @@ from typing import Any, Final
 
 import yaml
 
+from roverlab.errors import yaml_reason
+
 from ._store import STORE
 from ._values import default_message, from_dict, to_plain
 from .errors import MessageYAMLError
@@ -86,13 +88,6 @@ def _load(text: str) -> Any:
     return yaml.load(text, Loader=_Loader)
 
 
-def _reason(exc: yaml.YAMLError) -> str:
-    problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
-    mark = getattr(exc, "problem_mark", None)
-    where = f" (line {mark.line + 1}, column {mark.column + 1})" if mark is not None else ""
-    return f"{problem}{where}"
-
-
 def parse_yaml_message(typename: object, text: str) -> Any:
     """Build a message from YAML text, flow (``{linear: {x: 0.2}}``) or block form.
 
@@ -128,7 +123,7 @@ def parse_yaml_message(typename: object, text: str) -> Any:
             if isinstance(retry, dict) and not _has_colon_keys(retry):
                 data, error = retry, None
     if error is not None:
-        raise MessageYAMLError(f"invalid YAML for {spec.typename}: {_reason(error)}") from error
+        raise MessageYAMLError(f"invalid YAML for {spec.typename}: {yaml_reason(error)}") from error
     if data is None:
         return default_message(spec)
     if not isinstance(data, dict):

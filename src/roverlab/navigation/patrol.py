@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 import yaml
 
-from roverlab.errors import RoverlabError
+from roverlab.errors import RoverlabError, yaml_reason
 
 __all__ = ["PatrolError", "PatrolSequence", "PatrolStats", "Place", "load_places", "trunc"]
 
@@ -78,7 +78,7 @@ def load_places(path: str | os.PathLike[str]) -> tuple[str, list[Place]]:
     except OSError as err:
         raise PatrolError(f"{p}: cannot read: {err.strerror}") from err
     except yaml.YAMLError as err:
-        raise PatrolError(f"{p}: malformed YAML: {' '.join(str(err).split())}") from err
+        raise PatrolError(f"{p}: malformed YAML: {yaml_reason(err)}") from err
     if not isinstance(data, Mapping) or not isinstance(data.get("locations"), Mapping):
         raise PatrolError(f"{p}: expected a mapping with 'locations: {{name: pose, ...}}'")
     places = [_place(str(k), v, str(p)) for k, v in data["locations"].items()]

@@ -87,8 +87,11 @@ def _footprint(points: F64) -> F64:
     return np.ascontiguousarray(xy[hull.vertices])
 
 
+_NOISY = ("gaussian", "gaussian_quantized")  # Gazebo's types that add noise (no quantizing here)
+
+
 def _noise(n: NoiseSpec | None) -> ImuNoise:
-    if n is None:
+    if n is None or n.type not in _NOISY:  # Gazebo adds nothing for type "none"
         return ImuNoise()
     return ImuNoise(n.mean, n.stddev, n.bias_mean, n.bias_stddev)
 
@@ -162,8 +165,8 @@ def sim_config_from_model(model: RobotModel) -> RobotSimConfig:
                         range_min=r.range_min,
                         range_max=r.range_max,
                         range_resolution=r.range_resolution,
-                        noise_mean=r.noise_mean if r.noise_type == "gaussian" else 0.0,
-                        noise_stddev=r.noise_stddev if r.noise_type == "gaussian" else 0.0,
+                        noise_mean=r.noise_mean if r.noise_type in _NOISY else 0.0,
+                        noise_stddev=r.noise_stddev if r.noise_type in _NOISY else 0.0,
                     ),
                     mount=mount,
                     update_rate_hz=_rate(0.0, sensor.update_rate_hz, 10.0),
@@ -179,8 +182,8 @@ def sim_config_from_model(model: RobotModel) -> RobotSimConfig:
                 horizontal_fov=c.horizontal_fov,
                 clip_near=c.clip_near,
                 clip_far=c.clip_far,
-                noise_mean=c.noise_mean if c.noise_type == "gaussian" else 0.0,
-                noise_stddev=c.noise_stddev if c.noise_type == "gaussian" else 0.0,
+                noise_mean=c.noise_mean if c.noise_type in _NOISY else 0.0,
+                noise_stddev=c.noise_stddev if c.noise_type in _NOISY else 0.0,
             )
             cam = next(
                 (p.spec for p in sensor.plugins if isinstance(p.spec, CameraPluginSpec)), None

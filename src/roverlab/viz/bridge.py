@@ -373,6 +373,7 @@ class VizBridge:
             "pose_array": self._on_pose_array,
             "pose": self._on_pose,
             "pose_with_covariance": self._on_pose_with_covariance,
+            "polygon": self._on_polygon,
             "marker": self._on_marker,
             "marker_array": self._on_marker_array,
             "image": self._on_image,
@@ -529,6 +530,22 @@ class VizBridge:
             float(cov[5, 5]), rgb=_rgb(cfg), alpha=float(cfg.option("alpha")),
             length=float(cfg.option("length")), scale=float(cfg.option("covariance_scale")),
         )  # fmt: skip
+        state.frame = Versioned(self._next(), json.dumps(items))
+
+    def _on_polygon(self, state: DisplayState, msg: Any) -> None:
+        """rviz's Polygon display (a footprint): the closed outline, as a marker line."""
+        tf, why = self._lookup_why(str(msg.header.frame_id), _stamp_time(msg.header))
+        if not self._tf_status(state, tf, why):
+            return
+        assert tf is not None
+        pts = np.array([[p.x, p.y, p.z] for p in msg.polygon.points], dtype=np.float64)
+        items: list[dict[str, Any]] = []
+        if len(pts):
+            xy = tf.apply(pts)[:, :2].round(4).tolist()
+            r, g, b = _rgb(state.config)
+            rgba = [r / 255.0, g / 255.0, b / 255.0, float(state.config.option("alpha"))]
+            items.append({"shape": "polyline", "rgba": rgba, "width": 0.0,
+                          "points": [*xy, xy[0]]})  # fmt: skip
         state.frame = Versioned(self._next(), json.dumps(items))
 
     def _markers_changed(self, state: DisplayState) -> None:

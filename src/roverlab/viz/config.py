@@ -27,6 +27,7 @@ from typing import Any, Final
 
 import yaml
 
+from roverlab.errors import yaml_reason
 from roverlab.viz.errors import DashboardError
 
 __all__ = [
@@ -159,6 +160,13 @@ DISPLAY_KINDS: Final[dict[str, DisplayKind]] = {
             length=1.3,
         ),
         _kind(
+            "polygon",
+            ("geometry_msgs/msg/PolygonStamped",),
+            "/move_base/local_costmap/footprint",
+            color=[25, 255, 0],
+            alpha=1.0,
+        ),
+        _kind(
             "pose_with_covariance",
             ("geometry_msgs/msg/PoseWithCovarianceStamped",),
             "/amcl_pose",
@@ -192,6 +200,8 @@ RVIZ_CLASSES: Final[dict[str, str]] = {
     "rviz/MarkerArray": "marker_array",
     "rviz/Pose": "pose",
     "rviz/PoseWithCovariance": "pose_with_covariance",
+    "rviz/Polygon": "polygon",
+    "rviz/PolygonStamped": "polygon",
     "rviz/Image": "image",
     "rviz/Camera": "image",
 }
@@ -264,7 +274,8 @@ class DashboardConfig:
 
 def default_config(fixed_frame: str = "map") -> DashboardConfig:
     """What the dashboard shows without a file: grid, map, scan, robot, TF, odometry,
-    camera, plus disabled displays for plans, particles, clouds, markers and goals."""
+    camera, plus disabled displays for plans, particles, clouds, markers, goals and the
+    footprint."""
     enabled = ("grid", "map", "laser_scan", "robot_model", "tf", "odometry", "image")
     names = {
         "grid": "Grid",
@@ -288,6 +299,7 @@ def default_config(fixed_frame: str = "map") -> DashboardConfig:
         ("marker", "Marker", "/visualization_marker", {}),
         ("marker_array", "MarkerArray", "/visualization_marker_array", {}),
         ("pose", "Goal", "/move_base_simple/goal", {}),
+        ("polygon", "Footprint", "/move_base/local_costmap/footprint", {}),
         ("map", "Costmap", "/move_base/global_costmap/costmap", {"color_scheme": "costmap"}),
     ]
     displays += [DisplayConfig(k, n, False, t, o) for k, n, t, o in extra]
@@ -501,7 +513,7 @@ def parse_rviz(text: str, source: str = "<rviz>") -> DashboardConfig:
     try:
         data = yaml.safe_load(text)
     except yaml.YAMLError as err:
-        raise ConfigError(f"{source}: not a valid .rviz (YAML) file: {err}") from err
+        raise ConfigError(f"{source}: not a valid .rviz (YAML) file: {yaml_reason(err)}") from err
     manager = data.get("Visualization Manager") if isinstance(data, Mapping) else None
     if not isinstance(manager, Mapping):
         raise ConfigError(f"{source}: no 'Visualization Manager' section: not an .rviz file")

@@ -22,6 +22,8 @@ BUNDLED_WORLDS: dict[str, str] = {
     "maze": "8 m x 8 m Building Editor maze, 1.45 m corridors, spawn in the centre cell",
     "office": "12 m x 8 m office: reception, three rooms, desks, pillars, a face poster",
     "house": "10 m x 8 m house: living room, kitchen, bedroom, bathroom, furniture",
+    "warehouse": "14 m x 9 m warehouse: pallet racks and aisles, loading area, site office",
+    "apartment": "11 m x 9.5 m apartment: five rooms, a hallway, doors 0.8 to 1.6 m",
 }
 
 
@@ -37,7 +39,7 @@ def bundled_world_path(name: str) -> Path:
 def load_world(
     name_or_path: str | os.PathLike[str], *, model_path: Sequence[str | os.PathLike[str]] = ()
 ) -> World:
-    """Load a world by bundled name (``maze``, ``office``, ``house``, ``empty``) or file.
+    """Load a world by bundled name (:data:`BUNDLED_WORLDS`: ``maze``, ``office``...) or file.
 
     Files: ``.world`` / ``.sdf`` (Gazebo SDF), ``.yaml`` / ``.yml`` (a YAML world, or a
     map_server map YAML when it has ``image`` and ``resolution`` keys).

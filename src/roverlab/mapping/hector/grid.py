@@ -196,6 +196,32 @@ class MultiResGrid:
         self.log_odds_occupied = prob_to_log_odds(params.update_factor_occupied)
         self.updates = 0
 
+    def grow(self) -> None:
+        """Double every level's side, keeping what is mapped where it is in the world (the
+        old square sits in the middle of the new one). hector_mapping's map is fixed in
+        size; roverlab's offline runs grow it instead of failing when the robot nears an
+        edge."""
+        old_sizes, old_offsets = self.sizes.copy(), self.offsets.copy()
+        arrays = (self.logodds, self.prob, self.stamp)
+        self.sizes = old_sizes * 2
+        self.centers = self.centers + (old_sizes // 2)[:, None].astype(np.float64)
+        self.offsets = np.zeros_like(old_offsets)
+        self.offsets[1:] = np.cumsum(self.sizes[:-1] ** 2)
+        total = int((self.sizes**2).sum())
+        fresh = (
+            np.zeros(total, dtype=np.float32),
+            np.full(total, UNKNOWN_VALUE, dtype=np.float32),
+            np.zeros(total, dtype=np.int32),
+        )
+        for old, new in zip(arrays, fresh, strict=True):
+            for level, n in enumerate(old_sizes):
+                n, h = int(n), int(n) // 2
+                src = old[int(old_offsets[level]) : int(old_offsets[level]) + n * n].reshape(n, n)
+                m = 2 * n
+                dst = new[int(self.offsets[level]) : int(self.offsets[level]) + m * m].reshape(m, m)
+                dst[h : h + n, h : h + n] = src
+        self.logodds, self.prob, self.stamp = fresh
+
     def reset(self) -> None:
         """Forget everything: every cell back to unknown."""
         self.logodds[:] = 0.0

@@ -79,8 +79,14 @@ class HectorSLAM:
         laser_offset: SE2 = _IDENTITY,
         laser_z_m: float = 0.0,
         initial_pose: SE2 = _IDENTITY,
+        grow_max_size: int = 0,
     ) -> None:
+        """``grow_max_size``: when the robot or a scan's end point falls outside the map,
+        double the map (around its centre) until it holds them, up to this many cells per
+        side (0: hector_mapping's fixed map, which drops such end points and raises
+        :class:`OutOfMapError` when the robot leaves)."""
         self.params = params if params is not None else HectorParams()
+        self.grow_max_size = int(grow_max_size)
         self.laser_offset = laser_offset
         self.laser_z_m = float(laser_z_m)
         self.grid = MultiResGrid(self.params)
@@ -213,6 +219,7 @@ class HectorSLAM:
             if pts.shape[0] and self.grid.updates:
                 pose, self.last_hessian = self._match(pts, pose)
         pose[2] = wrap_angle(float(pose[2]))
+        self._grow_to_hold(pose, pts)
         self._check_inside(pose)
         self._last_odom = odom
         self._last_motion = _relative(self._pose, pose)
@@ -297,14 +304,32 @@ class HectorSLAM:
             poses=arr, map=self.occupancy(0), trajectory=Trajectory.from_poses(stamps, arr)
         )
 
+    def _grow_to_hold(self, pose: NDArray[np.float64], pts: NDArray[np.float64]) -> None:
+        """Double the map until it holds the robot and this scan's end points."""
+        x, y, th = float(pose[0]), float(pose[1]), float(pose[2])
+        if not (self.grow_max_size and math.isfinite(x) and math.isfinite(y)):
+            return
+        c, s = math.cos(th), math.sin(th)
+        xs = np.append(x + c * pts[:, 0] - s * pts[:, 1], x)
+        ys = np.append(y + s * pts[:, 0] + c * pts[:, 1], y)
+        lo, hi = (float(xs.min()), float(ys.min())), (float(xs.max()), float(ys.max()))
+        while not (self.grid.contains(*lo, 2.0) and self.grid.contains(*hi, 2.0)):
+            if 2 * int(self.grid.sizes[0]) > self.grow_max_size:
+                return
+            self.grid.grow()
+
     def _check_inside(self, pose: NDArray[np.float64]) -> None:
         x, y = float(pose[0]), float(pose[1])
         if not (math.isfinite(x) and math.isfinite(y)) or not self.grid.contains(x, y, 2.0):
             x0, y0, x1, y1 = self.grid.extent()
             raise OutOfMapError(
                 f"the robot at ({x:.2f}, {y:.2f}) m left the map "
-                f"[{x0:.2f}, {x1:.2f}] x [{y0:.2f}, {y1:.2f}] m; "
-                "increase map_size (or map_resolution) or move map_start_x/map_start_y"
+                f"[{x0:.2f}, {x1:.2f}] x [{y0:.2f}, {y1:.2f}] m"
+                + (
+                    f"; it cannot grow beyond {self.grow_max_size} cells per side"
+                    if self.grow_max_size
+                    else "; increase map_size (or map_resolution) or move map_start_x/map_start_y"
+                )
             )
 
 

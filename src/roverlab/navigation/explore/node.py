@@ -11,6 +11,14 @@ as explore_lite). With ``visualize`` the frontiers are published as markers on
 ``~frontiers`` (their cells, blue, red when blacklisted; a sphere at each, sized by cost).
 When no frontier is left it cancels move_base's goals and stops ("Exploration stopped.").
 
+Where roverlab differs from explore_lite, on purpose: a target within the blacklist's 5
+cells of the goal being pursued is the same goal (explore_lite: within 1 cm). A frontier's
+centroid moves by a few cells whenever the map grows; explore_lite then re-sends the goal
+and restarts its progress timer, and move_base restarts its patience and oscillation
+timers on the new goal, so a robot that cannot get to a frontier chases it for minutes.
+And a goal that move_base reached while its frontier is still the one chosen is
+blacklisted at once (explore_lite idles for ``progress_timeout`` first).
+
 Parameters (explore_lite's names and defaults): ``robot_base_frame`` base_link,
 ``costmap_topic`` costmap, ``costmap_updates_topic`` costmap_updates, ``visualize`` false,
 ``planner_frequency`` 1.0, ``progress_timeout`` 30.0, ``potential_scale`` 1e-3,
@@ -83,6 +91,7 @@ class Explore(Node):
         self.blacklist: list[tuple[float, float]] = []
         self.frontiers: list[Frontier] = []
         self._prev_goal: tuple[float, float] | None = None
+        self._active_goal: tuple[float, float] | None = None
         self._prev_distance = math.inf
         self._last_progress = 0.0
         self._timer = self.create_timer(1.0 / self.planner_frequency, self.make_plan)
@@ -136,8 +145,7 @@ class Explore(Node):
         return self.get_clock().now().nanoseconds / 1e9
 
     def _blacklisted(self, goal: tuple[float, float]) -> bool:
-        tol = _BLACKLIST_CELLS * float(self._info.resolution)
-        return any(abs(goal[0] - b[0]) < tol and abs(goal[1] - b[1]) < tol for b in self.blacklist)
+        return any(self._near(goal, b) for b in self.blacklist)
 
     def make_plan(self) -> None:
         """explore_lite's ``makePlan``: pick the cheapest frontier and pursue it."""
@@ -162,8 +170,11 @@ class Explore(Node):
             self.stop("every frontier is blacklisted")
             return
         target = frontier.centroid
-        same_goal = self._prev_goal == target
-        self._prev_goal = target
+        # explore_lite's "same goal" (it compares points with a 1 cm tolerance; see the
+        # module docstring for why roverlab uses the blacklist's)
+        same_goal = self._prev_goal is not None and self._near(self._prev_goal, target)
+        if not same_goal:
+            self._prev_goal = target
         now = self._now()
         if not same_goal or self._prev_distance > frontier.min_distance:
             self._last_progress = now
@@ -173,7 +184,15 @@ class Explore(Node):
             self.get_logger().debug("Adding current goal to black list")
             self.make_plan()
             return
+        if same_goal and self._active_goal is not None:
+            return  # still on its way there
         if same_goal:
+            # move_base reached this goal and the frontier is still there: nothing more can
+            # be seen from it (explore_lite waits progress_timeout before giving it up)
+            self.blacklist.append(target)
+            self.get_logger().debug("Goal reached but its frontier is left: black list")
+            self._prev_goal = None
+            self.make_plan()
             return
         goal = {
             "target_pose": {
@@ -182,9 +201,16 @@ class Explore(Node):
             }
         }
         self.goals_sent += 1
+        self._active_goal = target
         self.client.send_goal(goal, done_cb=lambda state, _r: self._reached(state, target))
 
+    def _near(self, a: tuple[float, float], b: tuple[float, float]) -> bool:
+        tol = _BLACKLIST_CELLS * float(self._info.resolution)
+        return abs(a[0] - b[0]) < tol and abs(a[1] - b[1]) < tol
+
     def _reached(self, state: int, target: tuple[float, float]) -> None:
+        if self._active_goal == target:
+            self._active_goal = None
         if state == GoalStatus.ABORTED:
             self.blacklist.append(target)
             self.get_logger().debug("Adding current goal to black list")

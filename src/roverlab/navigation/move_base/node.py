@@ -24,7 +24,10 @@ Differences from ROS 1, on purpose: a goal in a frame TF cannot turn into the gl
 frame is aborted with that reason (ROS uses it untransformed); a goal outside a static
 global costmap is aborted at once (ROS plans, fails and recovers for ``planner_patience``
 plus every recovery first); the clear_costmap recoveries clear every obstacle layer
-unless ``layer_names`` says otherwise (ROS 1 clears only layers named ``obstacles``).
+unless ``layer_names`` says otherwise (ROS 1 clears only layers named ``obstacles``); a
+failed plan in the PLANNING state stops the robot (ROS 1 leaves the last velocity command
+in force until ``planner_patience`` runs out, so a robot whose new goal cannot be planned
+drove on blind).
 """
 
 from __future__ import annotations
@@ -375,6 +378,11 @@ class MoveBase(Node):
         if self._make_plan(gpose, now):
             self.state = CONTROLLING
             return
+        if not self.server.is_active():
+            return
+        # no plan: the robot must not go on with the last command (a new goal preempting a
+        # moving robot; ROS 1 assumes "the robot isn't moving" here and lets it drive on)
+        self.publish_zero_velocity()
         p = self.params
         too_long = now > self._last_valid_plan + p.planner_patience
         too_many = 0 <= p.max_planning_retries < self._planning_retries

@@ -20,13 +20,14 @@
     point_cloud2: ["sensor_msgs/msg/PointCloud2"], marker: ["visualization_msgs/msg/Marker"],
     marker_array: ["visualization_msgs/msg/MarkerArray"], pose: ["geometry_msgs/msg/PoseStamped"],
     pose_with_covariance: ["geometry_msgs/msg/PoseWithCovarianceStamped"],
+    polygon: ["geometry_msgs/msg/PolygonStamped"],
     image: ["sensor_msgs/msg/Image", "sensor_msgs/msg/CompressedImage"], grid: [], tf: [],
   };
   const KIND_LABEL = {
     grid: "Grid", map: "Map", laser_scan: "LaserScan", robot_model: "RobotModel", tf: "TF",
     odometry: "Odometry", path: "Path", pose_array: "PoseArray", point_cloud2: "PointCloud2",
     marker: "Marker", marker_array: "MarkerArray", pose: "Pose",
-    pose_with_covariance: "PoseWithCovariance", image: "Image",
+    pose_with_covariance: "PoseWithCovariance", polygon: "Polygon", image: "Image",
   };
 
   // view: world point (cx, cy) at the canvas centre, `scale` pixels per metre, the screen's
@@ -345,6 +346,7 @@
     point_cloud2: { color_transformer: "AxisColor", color: [255, 255, 255], size_px: 2.0, alpha: 1.0, max_points: 20000, decay_s: 0.0 },
     marker: {}, marker_array: {}, pose: { color: [255, 25, 0], alpha: 1.0, length: 1.3 },
     pose_with_covariance: { color: [255, 25, 0], alpha: 1.0, length: 1.0, covariance_scale: 1.0 },
+    polygon: { color: [25, 255, 0], alpha: 1.0 },
     image: { color_map: "jet", min_value: 0.0, max_value: 0.0 },
   };
   const DEFAULT_TOPIC = {
@@ -352,6 +354,7 @@
     path: "/move_base/NavfnROS/plan", pose_array: "/particlecloud", point_cloud2: "/camera/depth/points",
     marker: "/visualization_marker", marker_array: "/visualization_marker_array",
     pose: "/move_base_simple/goal", pose_with_covariance: "/amcl_pose", image: "/image_raw",
+    polygon: "/move_base/local_costmap/footprint",
     grid: "", tf: "",
   };
   $("add-display").onclick = () => {
@@ -619,7 +622,7 @@
       case "pose": drawPoses(d, L, 0.04); break;
       case "pose_array": drawPoses(d, L, 0.06); break;
       case "path": drawPath(d, L); break;
-      case "marker": case "marker_array": case "pose_with_covariance": drawMarkers(L); break;
+      case "marker": case "marker_array": case "pose_with_covariance": case "polygon": drawMarkers(L); break;
       default: break;
     }
   }

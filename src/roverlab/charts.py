@@ -33,10 +33,12 @@ def write_line_chart(
     ylabel: str,
     y_range: tuple[float, float] | None = None,
     hline: tuple[float, str] | None = None,
+    markers: bool = False,
 ) -> None:
     """Draw ``(xs, ys, colour, label)`` series as lines on one chart and write it to
     ``path`` as PNG (temporary file, then rename). ``hline``: a dashed reference line
-    ``(y, label)``."""
+    ``(y, label)``; ``markers``: a dot on every point and whole-number x ticks (one point
+    per episode, say)."""
     font = ImageFont.load_default()
     img = Image.new("RGB", (_W, _H), "white")
     draw = ImageDraw.Draw(img)
@@ -58,6 +60,8 @@ def write_line_chart(
 
     draw.rectangle([_LEFT, _TOP, _LEFT + pw, _TOP + ph], outline=(0, 0, 0))
     for t in _ticks(x0, x1):
+        if markers and t != int(t):
+            continue
         u, _ = px(t, y0)
         draw.line([(u, _TOP + ph), (u, _TOP + ph + 4)], fill=(0, 0, 0))
         draw.line([(u, _TOP), (u, _TOP + ph)], fill=(230, 230, 230))
@@ -75,10 +79,10 @@ def write_line_chart(
     for k, (xs, ys, colour, label) in enumerate(series):
         pts = [px(float(x), float(y)) for x, y in zip(xs, ys, strict=True)]
         if len(pts) > 1:
-            draw.line(pts, fill=colour, width=2)
-        elif pts:
-            u, v = pts[0]
-            draw.ellipse([u - 2, v - 2, u + 2, v + 2], fill=colour)
+            draw.line(pts, fill=colour, width=1 if markers else 2)
+        if markers or len(pts) == 1:
+            for u, v in pts:
+                draw.ellipse([u - 3, v - 3, u + 3, v + 3], fill=colour)
         draw.text((_LEFT + 8, _TOP + ph - 16 - 12 * k), label, fill=colour, font=font)
     draw.text((_W / 2, 10), title, fill=(0, 0, 0), font=font, anchor="ma")
     draw.text((_LEFT + pw / 2, _H - 16), xlabel, fill=(0, 0, 0), font=font, anchor="ma")

@@ -1,0 +1,65 @@
+"""The ``--episodes N --workers K --ray-address`` part shared by ``roverlab explore`` and
+``roverlab nav bench``."""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import typer
+
+from roverlab.batch import Episode, EpisodeFn, run_batch, write_batch_outputs
+from roverlab.cli.common import stop_on_signals
+
+__all__ = ["run_episodes"]
+
+
+def _line(episode: Episode, done: int, total: int) -> str:
+    row = episode.row
+    if row.get("error"):
+        return f"[{done}/{total}] episode {row['episode']} (seed {row['seed']}): {row['error']}"
+    shown = ", ".join(
+        f"{k} {v:.4g}" if isinstance(v, float) else f"{k} {v}"
+        for k, v in row.items()
+        if k not in ("episode", "seed") and isinstance(v, (int, float, str)) and k != "world"
+    )
+    return f"[{done}/{total}] episode {row['episode']} (seed {row['seed']}): {shown}"
+
+
+def run_episodes(
+    fn: EpisodeFn,
+    config: dict[str, Any],
+    *,
+    episodes: int,
+    seed: int,
+    workers: int,
+    address: str | None,
+    out: Path,
+    plot: Sequence[tuple[str, str]],
+    title: str,
+) -> list[Episode]:
+    """Run the batch with a progress line per finished episode (stderr), write its
+    outputs, print the aggregate path. Ctrl-C / SIGTERM / SIGHUP: the finished episodes are
+    still written (a serial batch lets the running episode end early)."""
+    started = time.perf_counter()
+    with stop_on_signals(threading.Event()) as stop:
+        done = run_batch(
+            fn, config, episodes=episodes, seed=seed, workers=workers, address=address,
+            stop=stop,
+            on_done=lambda e, n, total: typer.echo(_line(e, n, total), err=True),
+        )  # fmt: skip
+    wall = time.perf_counter() - started
+    written = write_batch_outputs(
+        out, done, config=config, plot=plot, title=title, wall_s=wall,
+        workers=workers,
+    )  # fmt: skip
+    failed = sum(1 for e in done if e.row.get("error"))
+    typer.echo(
+        f"batch: {len(done)}/{episodes} episodes in {wall:.1f} s wall on "
+        f"{workers} worker(s), {failed} failed; {out / 'episodes.json'}"
+    )
+    typer.echo(f"wrote {len(written)} files under {out}", err=True)
+    return done
