@@ -1,11 +1,17 @@
 """Dashboard benchmark: frames per second the page renders, and the server's CPU share.
 
     python benchmarks/dashboard.py [--seconds S] [--map-cells N] [--update-map-every S]
+                                   [--view 3d|2d|both] [--cloud-max-points N]
 
 Serves the dashboard for an in-process system publishing a latched N x N OccupancyGrid
 (default 2,000 x 2,000), TF (``map -> odom -> base_link -> laser``, the robot driving a
-circle) and a 720-beam LaserScan at 10 Hz, opens the page in Debian's chromium (Playwright,
-headless, software rendering) and prints:
+circle), a 720-beam LaserScan at 10 Hz and a 640 x 480 depth PointCloud2 at 10 Hz (a
+curved wall in front of the robot, AxisColor; the display's Max Points decimates it on the
+server, 20,000 by default), opens the page in Debian's chromium (Playwright, headless,
+software rendering), in the 3D view (rviz's Orbit, three.js / WebGL on SwiftShader) and in
+the 2D view, and prints for each (the 3D view twice: with its adaptive resolution, which
+lowers the drawing-buffer resolution down to half per axis while the frame rate is below 28,
+and at fixed full resolution):
 
 - frames per second the page renders, counted with ``requestAnimationFrame`` in the browser
   over the window (target >= 30);
@@ -33,7 +39,7 @@ from playwright.sync_api import sync_playwright
 
 from roverlab.core import Context, QoSProfile, Time
 from roverlab.geometry import Transform3, quat_from_yaw
-from roverlab.msgs import array_to_occupancy_grid, make_scan, stamp_to_msg
+from roverlab.msgs import array_to_occupancy_grid, make_scan, stamp_to_msg, xyz_to_pointcloud2
 from roverlab.tf import StaticTransformBroadcaster, TransformBroadcaster
 from roverlab.tf.convert import transform_to_msg
 from roverlab.viz import DashboardServer
@@ -51,16 +57,28 @@ CHROMIUM_ARGS = [
 RESOLUTION_M = 0.05
 
 
-def _config() -> DashboardConfig:
+def _config(cloud_max_points: int) -> DashboardConfig:
     return DashboardConfig(
         fixed_frame="map",
         displays=[
             DisplayConfig("grid", "Grid", True, "", {}),
             DisplayConfig("map", "Map", True, "/map", {}),
             DisplayConfig("laser_scan", "LaserScan", True, "/scan", {}),
+            DisplayConfig(
+                "point_cloud2", "Depth", True, "/depth/points", {"max_points": cloud_max_points}
+            ),
             DisplayConfig("tf", "TF", True, "", {}),
         ],
     )
+
+
+def _depth_cloud() -> np.ndarray:
+    """A 640 x 480 depth camera's cloud (optical frame: z forward) of a curved wall."""
+    u, v = np.meshgrid(np.arange(640), np.arange(480))
+    fx = 525.0
+    z = 3.0 + 0.5 * np.sin(u / 80.0)
+    x, y = (u - 319.5) / fx * z, (v - 239.5) / fx * z
+    return np.column_stack((x.ravel(), y.ravel(), z.ravel())).astype(np.float32)
 
 
 def _system(ctx: Context, cells: int, update_every_s: float | None) -> None:
@@ -79,8 +97,16 @@ def _system(ctx: Context, cells: int, update_every_s: float | None) -> None:
         [
             transform_to_msg("map", "odom", Time(0), Transform3()),
             transform_to_msg("base_link", "laser", Time(0), Transform3((0.1, 0.0, 0.2))),
+            transform_to_msg(  # optical frame: z forward, x right, y down
+                "base_link",
+                "camera_depth",
+                Time(0),
+                Transform3((0.1, 0.0, 0.4), (-0.5, 0.5, -0.5, 0.5)),
+            ),
         ]
     )
+    cloud_pub = node.create_publisher("sensor_msgs/msg/PointCloud2", "/depth/points", 2)
+    cloud = _depth_cloud()
     tf = TransformBroadcaster(node)
     scan_pub = node.create_publisher("sensor_msgs/msg/LaserScan", "/scan", 5)
     state = {"k": 0}
@@ -104,6 +130,7 @@ def _system(ctx: Context, cells: int, update_every_s: float | None) -> None:
                 stamp=stamp_to_msg(now),
             )
         )
+        cloud_pub.publish(xyz_to_pointcloud2(cloud, "camera_depth", stamp_to_msg(now)))
         state["k"] += 1
         if update_every_s and state["k"] % max(1, round(update_every_s * 10)) == 0:
             x0 = int(rng.integers(0, cells - 100))
@@ -118,66 +145,117 @@ def _cpu_s() -> float:
     return t.user + t.system
 
 
+def _measure(
+    browser: Any, server: DashboardServer, view: str, seconds: float, *, adaptive: bool = True
+) -> dict[str, float]:
+    page = browser.new_page(viewport={"width": 1600, "height": 900})
+    cdp: Any = page.context.new_cdp_session(page)
+    cdp.send("Network.enable")
+    received = {"bytes": 0}
+
+    def on_frame(e: dict[str, Any]) -> None:
+        data = e["response"]["payloadData"]  # binary frames come base64-encoded
+        received["bytes"] += len(data) * 3 // 4 if e["response"]["opcode"] == 2 else len(data)
+
+    cdp.on("Network.webSocketFrameReceived", on_frame)
+    t0 = time.monotonic()
+    page.goto(server.url)
+    page.wait_for_function(
+        "() => window.viz && viz.cam && viz.data.map && viz.data.scan"
+        " && viz.data.layers.some(l => l && l.points && l.points.at(-1).stride === 3)",
+        timeout=60000,
+    )
+    first_map_s = time.monotonic() - t0
+    if view == "3d":  # rviz's Orbit, the whole 100 m map in view
+        page.evaluate(
+            "(adaptive) => { viz.setViewMode('Orbit'); viz.cam.distance = 90; viz.cam.pitch = 0.9;"
+            " viz.cam.focal.set(0, 0, 0); viz.cam.adaptive = adaptive; }",
+            adaptive,
+        )
+    else:
+        page.evaluate("() => { viz.setViewMode('2D'); viz.view.scale = 12; }")
+    page.wait_for_timeout(4000)  # the adaptive resolution settles
+    received["bytes"] = 0
+    cpu0, wall0 = _cpu_s(), time.monotonic()
+    frames = page.evaluate(
+        """(ms) => new Promise((done) => {
+             let n = 0; const end = performance.now() + ms;
+             function tick(t) {
+               n += 1;
+               if (t < end) requestAnimationFrame(tick); else done(n);
+             }
+             requestAnimationFrame(tick);
+           })""",
+        seconds * 1000,
+    )
+    wall = time.monotonic() - wall0
+    cpu = _cpu_s() - cpu0
+    drawn = page.evaluate("() => viz.data.layers[3].points.at(-1).n")  # the Depth display
+    ms = page.evaluate("() => [viz.cam.msUpdate || 0, viz.cam.msRender || 0, viz.cam.resolution]")
+    page.close()
+    return {
+        "fps": frames / wall,
+        "wall": wall,
+        "cpu": 100 * cpu / wall,
+        "kib": received["bytes"] / wall / 1024,
+        "first_map": first_map_s,
+        "cloud_points": float(drawn),
+        "ms_update": float(ms[0]),
+        "ms_render": float(ms[1]),
+        "resolution": float(ms[2]),
+    }
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--seconds", type=float, default=10.0, help="measuring window")
     ap.add_argument("--map-cells", type=int, default=2000, help="map side, cells")
     ap.add_argument("--update-map-every", type=float, default=None, help="seconds")
+    ap.add_argument("--view", choices=("3d", "2d", "both"), default="both")
+    ap.add_argument(
+        "--cloud-max-points", type=int, default=20000, help="the cloud display's Max Points"
+    )
     args = ap.parse_args()
     if not CHROMIUM.exists():
         sys.exit("needs /usr/bin/chromium (Debian's chromium package)")
     ctx = Context(clock="wall")
     _system(ctx, args.map_cells, args.update_map_every)
-    server = DashboardServer(ctx, "127.0.0.1", 0, config=_config())
+    server = DashboardServer(ctx, "127.0.0.1", 0, config=_config(args.cloud_max_points))
     ctx.spin_in_thread()
     server.start()
     pw = sync_playwright().start()
     browser = pw.chromium.launch(executable_path=str(CHROMIUM), args=CHROMIUM_ARGS)
     try:
-        page = browser.new_page(viewport={"width": 1600, "height": 900})
-        cdp: Any = page.context.new_cdp_session(page)
-        cdp.send("Network.enable")
-        received = {"bytes": 0}
-
-        def on_frame(e: dict[str, Any]) -> None:
-            data = e["response"]["payloadData"]  # binary frames come base64-encoded
-            received["bytes"] += len(data) * 3 // 4 if e["response"]["opcode"] == 2 else len(data)
-
-        cdp.on("Network.webSocketFrameReceived", on_frame)
-        t0 = time.monotonic()
-        page.goto(server.url)
-        page.wait_for_function("() => window.viz && viz.data.map && viz.data.scan", timeout=60000)
-        first_map_s = time.monotonic() - t0
-        page.evaluate("() => { viz.view.scale = 12; }")  # the whole 100 m map in view
-        page.wait_for_timeout(1000)
-        received["bytes"] = 0
-        cpu0, wall0 = _cpu_s(), time.monotonic()
-        frames = page.evaluate(
-            """(ms) => new Promise((done) => {
-                 let n = 0; const end = performance.now() + ms;
-                 function tick(t) {
-                   n += 1;
-                   if (t < end) requestAnimationFrame(tick); else done(n);
-                 }
-                 requestAnimationFrame(tick);
-               })""",
-            args.seconds * 1000,
-        )
-        wall = time.monotonic() - wall0
-        cpu = _cpu_s() - cpu0
-        fps = frames / wall
         print(
             f"dashboard benchmark ({platform.machine()}, {os.cpu_count()} cores, "
             f"Python {platform.python_version()}, chromium headless, software rendering)"
         )
         print(
             f"  map {args.map_cells} x {args.map_cells} cells, 720-beam scan at 10 Hz, "
-            f"robot moving (TF at 10 Hz), window {wall:.1f} s"
+            "640 x 480 depth cloud at 10 Hz, robot moving (TF at 10 Hz)"
         )
-        print(f"  first map on the page:      {first_map_s:6.2f} s after page load")
-        print(f"  page frame rate:            {fps:6.1f} fps (target >= 30)")
-        print(f"  server process CPU:         {100 * cpu / wall:6.1f} % of one core")
-        print(f"  websocket traffic:          {received['bytes'] / wall / 1024:6.1f} KiB/s")
+        runs = [("3d", True), ("3d", False), ("2d", True)]
+        for view, adaptive in runs:
+            if args.view not in ("both", view):
+                continue
+            r = _measure(browser, server, view, args.seconds, adaptive=adaptive)
+            what = (
+                ""
+                if view == "2d"
+                else (", adaptive resolution" if adaptive else ", full resolution")
+            )
+            print(f"  {view.upper()} view{what} (window {r['wall']:.1f} s):")
+            print(f"    first map on the page:    {r['first_map']:6.2f} s after page load")
+            print(f"    page frame rate:          {r['fps']:6.1f} fps (target >= 30)")
+            print(f"    cloud points drawn:       {r['cloud_points']:6.0f} of 307200 per frame")
+            if view == "3d":
+                print(
+                    f"    per frame:                {r['ms_update']:6.1f} ms scene update, "
+                    f"{r['ms_render']:.1f} ms WebGL render"
+                )
+                print(f"    adaptive resolution:      {r['resolution']:6.3f} of full (per axis)")
+            print(f"    server process CPU:       {r['cpu']:6.1f} % of one core")
+            print(f"    websocket traffic:        {r['kib']:6.1f} KiB/s")
     finally:
         browser.close()
         pw.stop()

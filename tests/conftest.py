@@ -23,6 +23,18 @@ def _free_port() -> int:
         return int(s.getsockname()[1])
 
 
+@pytest.fixture(scope="session", autouse=True)
+def _mesh_cache(tmp_path_factory: pytest.TempPathFactory) -> Iterator[None]:
+    """Processed meshes go to a per-session folder, not the user's ~/.cache."""
+    old = os.environ.get("ROVERLAB_CACHE_DIR")
+    os.environ["ROVERLAB_CACHE_DIR"] = str(tmp_path_factory.mktemp("cache"))
+    yield
+    if old is None:
+        os.environ.pop("ROVERLAB_CACHE_DIR", None)
+    else:
+        os.environ["ROVERLAB_CACHE_DIR"] = old
+
+
 @pytest.fixture(scope="session")
 def daemon(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
     """A daemon on a free loopback port; ROVERLAB_DAEMON points every process at it."""

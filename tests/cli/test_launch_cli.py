@@ -98,3 +98,14 @@ def test_bundled_mbot_navigation_has_the_seed_launch_files() -> None:
             assert [n.get_name() for n in started.nodes] == [node]
         finally:
             ctx.shutdown()
+
+
+def test_a_launch_with_driver_nodes_runs_on_wall_time(tmp_path: Path) -> None:
+    from roverlab.description import find_package
+
+    for pkg, launch_file in (
+        ("roborts_bringup", "launch/Ymap_move_face1.launch"),
+        ("urdlee", "launch/car_ee.launch"),
+    ):
+        mode, note = choose_clock(load_launch(find_package(pkg) / launch_file), "auto", 1.0)
+        assert mode == "wall" and "driver nodes" in note

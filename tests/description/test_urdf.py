@@ -115,17 +115,6 @@ BAD_CASES = {
         ),
         "<link name='a'>: <inertial>: <mass value='-1'>: negative mass",
     ),
-    "undefined_material": (
-        robot(
-            '<link name="a"><visual><geometry><sphere radius="1"/></geometry>'
-            '<material name="nowhere"/></visual></link>'
-        ),
-        "<link name='a'>: <visual> #1: material 'nowhere' is not defined",
-    ),
-    "color_out_of_range": (
-        robot('<material name="m"><color rgba="2 0 0 1"/></material>' + links("a")),
-        "<material name='m'>: <color rgba='2 0 0 1'>: values must be in [0, 1]",
-    ),
     "mimic_unknown_joint": (
         robot(links("a", "b") + joint("j", "a", "b", "continuous", '<mimic joint="ghost"/>')),
         "<joint name='j'>: <mimic joint='ghost'> is not a joint",

@@ -126,7 +126,9 @@ def test_output_log_keeps_info_off_the_screen_and_in_the_nodes_file(
         TF.format(name="quiet", extra=""),
         TF.format(name="loud", extra=' output="screen"'),
     ]))  # fmt: skip
-    configure_logging(logging.INFO)
+    root = logging.getLogger("roverlab")
+    saved = (root.handlers[:], root.level, root.propagate)
+    configure_logging(logging.INFO)  # to capsys's stderr: put the old handlers back after
     ctx = Context()
     try:
         launch = build_launch(path, context=ctx)
@@ -136,7 +138,7 @@ def test_output_log_keeps_info_off_the_screen_and_in_the_nodes_file(
             node.get_logger().warning(f"{name} warns")
     finally:
         ctx.shutdown()
-        configure_logging(logging.INFO)
+        root.handlers[:], root.level, root.propagate = saved
     err = capsys.readouterr().err
     assert "loud says hello" in err and "loud warns" in err and "quiet warns" in err
     assert "quiet says hello" not in err

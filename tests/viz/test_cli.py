@@ -107,3 +107,28 @@ def test_launch_rviz_on_a_taken_port_is_a_warning(monkeypatch: pytest.MonkeyPatc
         assert warnings and "not started" in warnings[0]
         assert "/rviz" not in ctx.nodes
         ctx.shutdown()
+
+
+def test_image_view_serves_the_image_panel_on_its_topic(daemon: str) -> None:
+    """``roverlab image view TOPIC`` (rqt_image_view): the dashboard with its image panel
+    enabled on TOPIC."""
+    port = _free_port()
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "roverlab.cli", "image", "view", "/usb_cam/image_raw",
+         "--port", str(port)],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    try:
+        deadline = time.monotonic() + 60
+        body = b""
+        while time.monotonic() < deadline and proc.poll() is None and not body:
+            try:
+                _, body = _get(f"http://127.0.0.1:{port}/config")
+            except OSError:
+                time.sleep(0.2)
+        assert body, "the image view did not come up"
+        images = [d for d in json.loads(body)["displays"] if d["kind"] == "image"]
+        assert [(d["topic"], d["enabled"]) for d in images] == [("/usb_cam/image_raw", True)]
+    finally:
+        proc.terminate()
+        proc.communicate(timeout=30)

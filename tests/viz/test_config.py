@@ -170,3 +170,40 @@ def test_unreadable_file_is_a_config_error(tmp_path: Path) -> None:
     bad.write_text("{ nope")
     with pytest.raises(ConfigError, match="not valid JSON"):
         load_config(bad)
+
+
+def test_rviz_views_pick_the_3d_view() -> None:
+    orbit = load_rviz(FIXTURES / "test.rviz").view
+    assert orbit["mode"] == "Orbit" and orbit["target_frame"] == ""
+    assert orbit["distance"] == pytest.approx(6.24399, abs=1e-4)
+    assert orbit["yaw"] == pytest.approx(0.84040, abs=1e-4)
+    assert orbit["pitch"] == pytest.approx(0.37040, abs=1e-4)
+    assert orbit["focal_point"][0] == pytest.approx(-0.67816, abs=1e-4)
+    text = (FIXTURES / "test.rviz").read_text()
+    top = parse_rviz(
+        text.replace("Class: rviz/Orbit", "Class: rviz/TopDownOrtho\n      Scale: 110\n      X: 2"),
+        "top.rviz",
+    ).view
+    assert top["mode"] == "TopDownOrtho" and top["scale"] == 110 and top["x"] == 2
+    follow = parse_rviz(
+        text.replace("Class: rviz/Orbit", "Class: rviz/ThirdPersonFollower").replace(
+            "Target Frame: <Fixed Frame>", "Target Frame: base_link"
+        ),
+        "follow.rviz",
+    ).view
+    assert follow["mode"] == "ThirdPersonFollower" and follow["target_frame"] == "base_link"
+    no_views = parse_rviz(text.split("  Views:")[0], "none.rviz")
+    assert no_views.view == {"mode": "2D"}
+
+
+def test_saved_view_round_trips_and_bad_view_is_one_error(tmp_path: Path) -> None:
+    config = load_rviz(FIXTURES / "test.rviz")
+    path = save_config(config, tmp_path / "dash.json")
+    assert load_config(path).view == config.view
+    data = config.to_dict()
+    data["view"] = {"mode": "Fisheye"}
+    with pytest.raises(ConfigError, match="view must be a mapping with mode one of"):
+        config_from_dict(data, "dash.json")
+    data["view"] = {"mode": "Orbit", "distance": "far"}
+    with pytest.raises(ConfigError, match=r"dash\.json: view distance must be a number"):
+        config_from_dict(data, "dash.json")

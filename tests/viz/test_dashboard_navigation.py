@@ -1,6 +1,8 @@
 """Seed 003's flow in the browser: mybot in the maze, map_server + amcl + move_base from
 robot_navigation's navigation_stack.launch, the dashboard on its navigation.rviz; a 2D Nav
-Goal dragged on the map drives the robot there and the action reports SUCCEEDED."""
+Goal dragged on the map drives the robot there and the action reports SUCCEEDED. The file's
+view is rviz/TopDownOrtho, so the page shows the 3D view's orthographic top camera and the
+tool casts the mouse onto the ground plane."""
 
 from __future__ import annotations
 
@@ -19,7 +21,7 @@ from roverlab.navigation.move_base.node import MoveBase
 from roverlab.sim.node import SimulatorNode
 from roverlab.viz import DashboardServer
 from roverlab.viz.config import load_rviz
-from tests.viz.test_dashboard import CHROMIUM, CHROMIUM_ARGS, VIEWPORT, _to_screen, _view, _wait
+from tests.viz.test_dashboard import CHROMIUM, CHROMIUM_ARGS, VIEWPORT, _wait
 
 playwright_sync = pytest.importorskip("playwright.sync_api", reason="playwright not installed")
 
@@ -83,23 +85,24 @@ def test_2d_nav_goal_in_the_dashboard_drives_the_robot(nav: Nav, tmp_path: Path)
             " && viz.data.layers[i] && (viz.data.layers[i].markers || []).length === 1)",
             timeout=20000,
         )
-        v = _view(page)
+        assert page.evaluate("() => viz.cam.mode") == "TopDownOrtho"  # navigation.rviz's view
+        assert page.evaluate("() => viz.cam.scale") == 110
         gx, gy = -0.5, 0.4  # a free place of the maze
-        px, py = _to_screen(v, gx, gy)
-        box = page.locator("#view").bounding_box()
+        px, py = page.evaluate(f"() => viz.worldToScreen3({gx}, {gy}, 0)")
+        box = page.locator("#view3d").bounding_box()
         page.click("#toolbar button[data-tool='goal']")
         page.mouse.move(box["x"] + px, box["y"] + py)
         page.mouse.down()
         page.mouse.move(box["x"] + px + 60, box["y"] + py, steps=6)  # facing +x on screen
         page.mouse.up()
         page.wait_for_timeout(1500)
-        page.locator("#view").screenshot(path=str(tmp_path / "nav_goal_underway.png"))
+        page.locator("#view3d").screenshot(path=str(tmp_path / "nav_goal_underway.png"))
         assert _wait(lambda: bool(nav.results), 120.0), "no result on /move_base/result"
         status = nav.results[-1].status
         assert (status.status, status.text) == (3, "Goal reached.")  # SUCCEEDED
         assert math.hypot(nav.sim.x - gx, nav.sim.y - gy) < 0.2
         page.wait_for_timeout(500)
-        page.locator("#view").screenshot(path=str(tmp_path / "nav_goal_reached.png"))
+        page.locator("#view3d").screenshot(path=str(tmp_path / "nav_goal_reached.png"))
         assert not errors, errors
     finally:
         browser.close()

@@ -174,3 +174,49 @@ def test_initialpose_covariance_is_rviz_default() -> None:
 def test_loopback_hosts() -> None:
     assert is_loopback("127.0.0.1") and is_loopback("localhost") and is_loopback("::1")
     assert not is_loopback("0.0.0.0") and not is_loopback("192.168.1.5")
+
+
+def test_points_in_3d_with_per_point_rgb() -> None:
+    from roverlab.viz.protocol import POINTS_RGB, POINTS_XYZ, encode_points
+
+    xyz = np.array([[1.0, 2.0, 0.5], [3.0, 4.0, 1.5]])
+    rgb = np.array([[255, 0, 0], [0, 0, 255]], dtype=np.uint8)
+    frame = encode_points(xyz, None, [[255, 255, 255, 128]], rgb=rgb, slot=3)
+    kind, flags, slot, n, nb = struct.unpack_from("<BBHII", frame)
+    assert (kind, flags, slot, n, nb) == (KIND_POINTS, POINTS_XYZ | POINTS_RGB, 3, 2, 1)
+    at = 12 + 8 * nb
+    pts = np.frombuffer(frame, "<f4", 6, at).reshape(2, 3)
+    np.testing.assert_allclose(pts, xyz)
+    colours = np.frombuffer(frame, np.uint8, 8, at + 24).reshape(2, 4)
+    assert colours.tolist() == [[255, 0, 0, 128], [0, 0, 255, 128]]
+    flat = encode_points(xyz[:, :2])  # 2-D points keep the old layout (no flags)
+    assert struct.unpack_from("<B", flat, 1)[0] == 0
+
+
+def test_robot_shapes_keep_geometry_origin_and_colour() -> None:
+    from roverlab.viz.protocol import robot_shapes
+
+    model = parse_urdf(
+        """<robot name="r">
+        <link name="base_link"><visual><origin xyz="0 0 0.1"/>
+          <geometry><cylinder radius="0.2" length="0.1"/></geometry>
+          <material name="y"><color rgba="1 1 0 0.5"/></material></visual></link>
+        <link name="cam"><visual><geometry><box size="0.1 0.2 0.3"/></geometry></visual>
+          <visual><geometry><mesh filename="package://p/m.stl" scale="2 2 2"/></geometry></visual>
+        </link>
+        <joint name="j" type="fixed"><parent link="base_link"/><child link="cam"/></joint>
+        </robot>""",
+        source="r.urdf",
+    )
+    shapes = {(s.link, s.geometry["type"]): s for s in robot_shapes(model)}
+    cyl = shapes[("base_link", "cylinder")]
+    assert cyl.geometry == {"type": "cylinder", "radius": 0.2, "length": 0.1}
+    assert cyl.origin == [0.0, 0.0, 0.1, 0.0, 0.0, 0.0, 1.0]
+    assert cyl.rgba == (1.0, 1.0, 0.0, 0.5)
+    assert shapes[("cam", "box")].geometry["size"] == [0.1, 0.2, 0.3]
+    assert shapes[("cam", "box")].rgba == (0.6, 0.6, 0.6, 1.0)
+    assert shapes[("cam", "mesh")].geometry == {
+        "type": "mesh",
+        "filename": "package://p/m.stl",
+        "scale": [2.0, 2.0, 2.0],
+    }

@@ -27,6 +27,9 @@ ROBOT_RADIUS = 0.125  # a 0.25 m robot
 # Points that a robot starting at the origin must be able to reach (one per room).
 ROOMS: dict[str, list[tuple[float, float]]] = {
     "maze": [(-4.0 + 1.6 * (c + 0.5), -4.0 + 1.6 * (r + 0.5)) for c in range(5) for r in range(5)],
+    "maze_faces": [
+        (-4.0 + 1.6 * (c + 0.5), -4.0 + 1.6 * (r + 0.5)) for c in range(5) for r in range(5)
+    ],
     "office": [(-2.0, -2.0), (-2.0, 2.0), (6.0, -1.5), (4.5, 1.5), (6.6, 3.5), (8.3, 0.8)],
     "house": [(-2.5, 0.5), (4.5, -1.5), (-1.0, 3.0), (3.5, 3.0)],
     "empty": [(3.0, 3.0)],

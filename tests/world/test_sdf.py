@@ -19,6 +19,7 @@ from roverlab.world import (
     SphereShape,
     WorldError,
     load_sdf,
+    world_warnings,
 )
 from roverlab.world.sdf import BUNDLED_MODELS_DIR, model_search_path
 
@@ -508,14 +509,16 @@ def test_malformed_xml_names_the_line(tmp_path: Path) -> None:
     _one_line_error(f, "bad.world:4:", "malformed XML")
 
 
-def test_missing_include_lists_the_searched_paths(tmp_path: Path) -> None:
+def test_missing_include_is_a_grouped_warning_listing_the_searched_paths(tmp_path: Path) -> None:
     f = write(
         tmp_path / "w.world", world_sdf("<include>\n<uri>model://nowhere_model</uri>\n</include>")
     )
-    msg = _one_line_error(
-        f, "model://nowhere_model", "not found", str(BUNDLED_MODELS_DIR), str(tmp_path)
-    )
-    assert ":5:" in msg  # the <uri> line
+    w = load_sdf(f)
+    assert w.shapes == () or list(w.shapes) == []
+    assert len(w.warnings) == 1 and ":5:" in w.warnings[0]  # the <uri> line
+    (line,) = world_warnings(w)
+    assert line.startswith("1 model skipped: nowhere_model — model://nowhere_model not found")
+    assert str(BUNDLED_MODELS_DIR) in line and str(tmp_path) in line
 
 
 @pytest.mark.parametrize(

@@ -156,7 +156,8 @@ def test_unknown_suffix_and_missing_file(tmp_path: Path) -> None:
     with pytest.raises(WorldError, match="not found"):
         load_world(tmp_path / "none.yaml")
     with pytest.raises(
-        WorldError, match="bundled worlds are apartment, empty, house, maze, office, warehouse"
+        WorldError,
+        match="bundled worlds are apartment, empty, house, maze, maze_faces, office, warehouse",
     ):
         load_world("mze")
 

@@ -16,12 +16,14 @@ import typer
 from roverlab.core import Context
 from roverlab.core.errors import TransportError
 from roverlab.core.transport.daemon import ensure_daemon
+from roverlab.core.transport.interfaces import split_wildcard_listen
 from roverlab.core.transport.zenoh import (
     GraphEntity,
     ZenohOptions,
     ZenohTransport,
     query_graph,
 )
+from roverlab.errors import RoverlabError
 
 __all__ = [
     "FOLLOWER_CLOCKS",
@@ -29,6 +31,7 @@ __all__ = [
     "NetworkOptions",
     "choose_expose",
     "connect_following_clock",
+    "is_loopback_endpoint",
     "network_options",
     "run_context",
     "stop_on_signals",
@@ -38,6 +41,18 @@ __all__ = [
 FOLLOWER_CLOCKS = ("auto", "wall", "external")
 
 _SETTLE_S = 0.3
+_CONNECT_TIMEOUT_S = 5.0
+_LOOPBACK_HOSTS = ("localhost", "::1", "ip6-localhost")
+
+
+def is_loopback_endpoint(endpoint: str) -> bool:
+    """Whether a Zenoh endpoint (``tcp/127.0.0.1:7447``, ``unixsock-stream/...``) can only
+    be reached from this machine."""
+    proto, _, addr = endpoint.partition("/")
+    if proto.startswith("unixsock"):
+        return True
+    host = addr.split("#")[0].rpartition(":")[0].strip("[]")
+    return host in _LOOPBACK_HOSTS or host.startswith("127.")
 
 
 @dataclass(frozen=True)
@@ -52,8 +67,23 @@ class NetworkOptions:
     tls_cert: str | None = None
     tls_key: str | None = None
     multicast: bool = False
+    insecure: bool = False
 
     def zenoh_options(self) -> ZenohOptions:
+        """The transport settings; an explicit ``--connect`` fails fast (5 s) with a clear
+        error when the other side refuses the session or nothing listens there.
+
+        Raises:
+            RoverlabError: a non-loopback ``--listen`` without ``--user``/``--password``
+                and without ``--insecure``.
+        """
+        exposed = [ep for ep in self.listen if not is_loopback_endpoint(ep)]
+        if exposed and self.user is None and not self.insecure:
+            raise RoverlabError(
+                f"refusing to listen on {', '.join(exposed)} without authentication: anyone "
+                "on that network could read the robot's topics and drive it. Give --user and "
+                "--password (the same on both machines), or --insecure on a network you trust"
+            )
         opts = ZenohOptions(
             listen=self.listen,
             connect=self.connect,
@@ -63,9 +93,20 @@ class NetworkOptions:
             tls_cert=self.tls_cert,
             tls_key=self.tls_key,
             multicast_scouting=self.multicast,
+            connect_timeout_s=_CONNECT_TIMEOUT_S if self.connect else None,
         )
         if not opts.connect and not self.multicast:
-            opts = replace(opts, connect=(ensure_daemon(),))
+            daemon = ensure_daemon()
+            # A robot listening with a password still joins its own machine's daemon
+            # (which asks for none): it checks the password of sessions that come in and
+            # offers none itself. ``tcp/0.0.0.0:7447`` becomes one endpoint per address of
+            # the machine, leaving 127.0.0.1:7447 to the daemon.
+            opts = replace(
+                opts,
+                connect=(daemon,),
+                listen=split_wildcard_listen(opts.listen, daemon),
+                present_credentials=False,
+            )
         return opts
 
 
@@ -96,6 +137,21 @@ class Connection:
 
     def __exit__(self, *exc: Any) -> None:
         self.close()
+
+
+def report_warnings(title: str, lines: list[str], strict: bool) -> None:
+    """Print a loader's warnings loudly on stderr under a count; with ``--strict`` they
+    are errors (exit status 2) rather than warnings."""
+    if not lines:
+        return
+    label = "error" if strict else "warning"
+    noun = "problem" if len(lines) == 1 else "problems"
+    typer.echo(f"{label}: {title}: {len(lines)} {noun}:", err=True)
+    for line in lines:
+        typer.echo(f"  - {line}", err=True)
+    if strict:
+        typer.echo(f"error: --strict: {title} is not loaded as its files say", err=True)
+        raise typer.Exit(2)
 
 
 def network_options(ctx: typer.Context) -> NetworkOptions:

@@ -9,7 +9,7 @@ from typing import Annotated
 import typer
 
 from roverlab.bag import McapRecorder
-from roverlab.cli.common import choose_expose, network_options, run_context
+from roverlab.cli.common import choose_expose, network_options, report_warnings, run_context
 from roverlab.cli.sim import parse_rate
 from roverlab.core import Context, configure_logging
 from roverlab.core.transport.zenoh import ZenohTransport
@@ -18,6 +18,14 @@ from roverlab.launch import LaunchError, LaunchSpec, build_launch, load_launch
 
 CLOCKS = ("auto", "sim", "external", "wall")
 _SIMULATOR_NODES = {("gazebo_ros", "gzserver"), ("gazebo_ros", "spawn_model")}
+_DEVICE_NODES = {
+    ("arbotix_python", "arbotix_driver"),
+    ("rplidar_ros", "rplidarNode"),
+    ("rplidar_ros", "rplidar_node"),
+    ("usb_cam", "usb_cam_node"),
+    ("ros_arduino_python", "arduino_node.py"),
+    ("roborts_base", "roborts_base_node"),
+}
 
 
 def choose_clock(spec: LaunchSpec, clock: str, pace: float) -> tuple[str, str]:
@@ -26,8 +34,9 @@ def choose_clock(spec: LaunchSpec, clock: str, pace: float) -> tuple[str, str]:
     ``auto``: a launch with a simulator (gzserver / spawn_model) runs it on its own clock
     (paced by ``--rate``); one without follows ``/clock`` from another process (a
     ``roverlab sim`` in another terminal: what ROS does with ``/use_sim_time`` true, which
-    a Gazebo launch sets for everybody), unless the file sets ``/use_sim_time`` false,
-    which means wall time.
+    a Gazebo launch sets for everybody), unless the file sets ``/use_sim_time`` false or
+    starts a driver node (arbotix, a lidar, a camera, a serial base: a real robot or
+    arbotix's fake one), which means wall time.
     """
     if clock not in CLOCKS:
         raise LaunchError(f"unknown --clock {clock!r} ({', '.join(CLOCKS)})")
@@ -40,6 +49,11 @@ def choose_clock(spec: LaunchSpec, clock: str, pace: float) -> tuple[str, str]:
         return own, ""
     if spec.params.get("/use_sim_time") is False:
         return "wall", "no simulator in this launch and /use_sim_time is false: wall time"
+    if any((n.pkg, n.type) in _DEVICE_NODES for n in spec.nodes):
+        return "wall", (
+            "driver nodes (arbotix, a lidar, a camera, a serial base) and no simulator in this "
+            "launch: wall time, as ROS without /use_sim_time"
+        )
     return "external", (
         "no simulator in this launch: following /clock from another process "
         "(start `roverlab sim` elsewhere, or pass --clock wall)"
@@ -98,6 +112,14 @@ def launch(
             "always its own clock (paced by --rate); external; wall.",
         ),
     ] = "auto",
+    strict: Annotated[
+        bool,
+        typer.Option(
+            "--strict",
+            help="Make every warning (a node roverlab does not have, an unused parameter, "
+            "a world model or mesh not found, an unsupported robot plugin) an error.",
+        ),
+    ] = False,
 ) -> None:
     """Run a .launch file (roslaunch): its nodes, its Gazebo world and spawned robot."""
     path, args = _resolve(target)
@@ -121,8 +143,15 @@ def launch(
             recorder.abort()
         context.shutdown()
         raise
-    for warning in started.warnings:
-        typer.echo(f"warning: {warning}", err=True)
+    try:
+        report_warnings(f"launch {path.name}", started.warnings, strict)
+        report_warnings("Gazebo world", started.world_warnings, strict)
+        report_warnings("spawned robot", started.robot_warnings, strict)
+    except BaseException:
+        if recorder is not None:
+            recorder.abort()
+        context.shutdown()
+        raise
     names = ", ".join(n.get_fully_qualified_name() for n in started.nodes)
     typer.echo(f"started {len(started.nodes)} nodes: {names}", err=True)
     started.supervise()

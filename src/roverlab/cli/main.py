@@ -59,6 +59,11 @@ app.command(
     context_settings={"allow_extra_args": True, "ignore_unknown_options": True},
 )(run.run)
 app.command("dashboard")(viz_cli.dashboard)
+image_app = typer.Typer(
+    help="Camera images (rqt_image_view) in the dashboard's image panel.", no_args_is_help=True
+)
+image_app.command("view")(viz_cli.image_view)
+app.add_typer(image_app, name="image")
 app.add_typer(urdf_cli.app, name="urdf")
 app.add_typer(map_cli.app, name="map")
 slam_cli.app.command("run")(slam_run.run)
@@ -115,6 +120,14 @@ def root(
             "--multicast", help="Find peers by UDP multicast on the LAN (off by default)."
         ),
     ] = False,
+    insecure: Annotated[
+        bool,
+        typer.Option(
+            "--insecure",
+            help="Allow --listen beyond loopback without --user/--password (a trusted "
+            "network only: anyone on it can read and drive the robot).",
+        ),
+    ] = False,
 ) -> None:
     """roverlab: simulate, map, localise, navigate and inspect robots the ROS way."""
     ctx.obj = NetworkOptions(
@@ -126,6 +139,7 @@ def root(
         tls_cert=tls_cert,
         tls_key=tls_key,
         multicast=multicast,
+        insecure=insecure,
     )
 
 

@@ -10,12 +10,20 @@ from typing import Annotated
 import typer
 
 from roverlab.bag import McapRecorder
-from roverlab.cli.common import choose_expose, network_options, run_context, stop_on_signals
+from roverlab.cli.common import (
+    choose_expose,
+    network_options,
+    report_warnings,
+    run_context,
+    stop_on_signals,
+)
 from roverlab.core import Context, configure_logging
 from roverlab.core.transport.zenoh import ZenohTransport
+from roverlab.description.check import robot_warnings
 from roverlab.sim.app import Simulation, SimulationError
 from roverlab.sim.node import SpawnPose
 from roverlab.viz.server import DashboardServer
+from roverlab.world import world_warnings
 
 
 def parse_rate(text: str) -> float:
@@ -97,6 +105,14 @@ def sim(
     dashboard_port: Annotated[
         int, typer.Option("--dashboard-port", help="Port of the --dashboard (127.0.0.1).")
     ] = 8080,
+    strict: Annotated[
+        bool,
+        typer.Option(
+            "--strict",
+            help="Make every world and robot warning (a model or mesh not found, an "
+            "unsupported element or plugin) an error.",
+        ),
+    ] = False,
 ) -> None:
     """Simulate a robot in a world: /cmd_vel in; /odom, /tf, /scan, /imu, cameras, /clock out."""
     pace = parse_rate(rate)
@@ -123,6 +139,7 @@ def sim(
             dashboard=dashboard,
             dashboard_port=dashboard_port,
             duration=duration,
+            strict=strict,
         )
 
 
@@ -142,6 +159,7 @@ def _run(
     dashboard: bool,
     dashboard_port: int,
     duration: float | None,
+    strict: bool,
 ) -> None:
     recorder: McapRecorder | None = None
     try:
@@ -155,6 +173,12 @@ def _run(
             spawn=spawn,
             seed=seed,
             robot_args=args,
+        )
+        report_warnings(
+            f"world {simulation.world_model.name}", world_warnings(simulation.world_model), strict
+        )
+        report_warnings(
+            f"robot {simulation.robot_model.name}", robot_warnings(simulation.robot_model), strict
         )
         if choose_expose(expose, pace):
             context.add_transport(ZenohTransport(network_options(ctx).zenoh_options()))

@@ -29,7 +29,28 @@ from roverlab.description.gazebo import (
 )
 from roverlab.description.model import RobotModel
 
-__all__ = ["format_check", "format_tree"]
+__all__ = ["format_check", "format_tree", "robot_warnings"]
+
+
+def robot_warnings(model: RobotModel) -> list[str]:
+    """Everything about the robot a simulation will not do as the file says, one line
+    each: urdfdom's accepted oddities, unsupported Gazebo plugins and sensors, and
+    ``<gazebo reference>`` names that match nothing."""
+    out = list(model.warnings)
+    src = model.source
+    plugins = list(dict.fromkeys(p.filename for p in model.gazebo.unsupported_plugins))
+    sensors = list(dict.fromkeys(s.type for s in model.gazebo.unsupported_sensors))
+    if plugins:
+        out.append(f"{src}: Gazebo plugins not simulated (ignored): {', '.join(plugins)}")
+    if sensors:
+        out.append(f"{src}: Gazebo sensor types not simulated (ignored): {', '.join(sensors)}")
+    unknown = [r for r in model.gazebo.references if r not in model.links and r not in model.joints]
+    if unknown:
+        out.append(
+            f"{src}: <gazebo reference> names no link or joint (ignored): "
+            + ", ".join(f"'{r}'" for r in unknown)
+        )
+    return out
 
 
 def format_tree(model: RobotModel) -> str:
@@ -139,4 +160,5 @@ def format_check(model: RobotModel) -> str:
             "warning: <gazebo reference> names no link or joint: "
             + ", ".join(f"'{r}'" for r in unknown)
         )
+    lines.extend(f"warning: {w}" for w in model.warnings)
     return "\n".join(lines)

@@ -55,6 +55,25 @@ PackagePathOption = Annotated[
 ]
 
 
+XacroNsOption = Annotated[
+    bool,
+    typer.Option(
+        "--xacro-ns",
+        help="As ROS 1's xacro --xacro-ns: only xacro:-prefixed tags are xacro's "
+        "(default: ROS 1's un-prefixed <macro>, <property>, ... and macro calls are "
+        "accepted with its deprecation warning).",
+    ),
+]
+InorderOption = Annotated[
+    bool,
+    typer.Option(
+        "--inorder",
+        "-i",
+        help="Accepted for ROS 1 command lines: in-order processing is always on.",
+    ),
+]
+
+
 @app.command("check")
 def check(
     file: Annotated[Path, typer.Argument(help="A .urdf, .xacro or .urdf.xacro file.")],
@@ -66,11 +85,13 @@ def check(
         typer.Option("--arg", "-a", help="A xacro argument, name:=value (repeatable)."),
     ] = None,
     package_path: PackagePathOption = None,
+    xacro_ns: XacroNsOption = False,
+    inorder: InorderOption = False,
 ) -> None:
     """Parse FILE and print its link tree as check_urdf does, then its sensors and plugins."""
     try:
         args = parse_mappings([*(arg or []), *(mappings or [])])
-        model = load_robot(file, args=args, package_path=package_path or ())
+        model = load_robot(file, args=args, package_path=package_path or (), xacro_ns=xacro_ns)
     except DescriptionError as err:
         raise _fail(err) from err
     typer.echo(format_check(model))
@@ -86,10 +107,14 @@ def xacro(
         Path | None, typer.Option("--output", "-o", help="Write to this file, not stdout.")
     ] = None,
     package_path: PackagePathOption = None,
+    xacro_ns: XacroNsOption = False,
+    inorder: InorderOption = False,
 ) -> None:
     """Print the URDF that FILE expands to (what `xacro FILE > out.urdf` writes)."""
     try:
-        text = robot_description(file, parse_mappings(mappings), package_path=package_path or ())
+        text = robot_description(
+            file, parse_mappings(mappings), package_path=package_path or (), xacro_ns=xacro_ns
+        )
     except DescriptionError as err:
         raise _fail(err) from err
     if output is None:

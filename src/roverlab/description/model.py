@@ -37,6 +37,7 @@ __all__ = [
     "JointDynamics",
     "JointLimit",
     "JointMimic",
+    "JointSafety",
     "JointType",
     "Link",
     "Material",
@@ -172,6 +173,16 @@ class JointDynamics:
 
 
 @dataclass(frozen=True, slots=True)
+class JointSafety:
+    """``<safety_controller>``: soft limits (rad or m) and the gains pulling back to them."""
+
+    k_velocity: float
+    soft_lower_limit: float = 0.0
+    soft_upper_limit: float = 0.0
+    k_position: float = 0.0
+
+
+@dataclass(frozen=True, slots=True)
 class Joint:
     """A joint: ``parent_T_child = origin * motion(position)``.
 
@@ -191,6 +202,7 @@ class Joint:
     limit: JointLimit | None = None
     mimic: JointMimic | None = None
     dynamics: JointDynamics | None = None
+    safety: JointSafety | None = None
 
     @property
     def movable(self) -> bool:
@@ -227,6 +239,7 @@ class RobotModel:
         gazebo: what the ``<gazebo>`` tags say.
         source: the file (or ``<string>``) the model came from, used in error messages.
         urdf: the URDF XML the model was parsed from (what ``/robot_description`` holds).
+        warnings: what the parser accepted as urdfdom does but reports.
 
     Raises:
         URDFError: the joints do not form one tree over the links.
@@ -239,6 +252,8 @@ class RobotModel:
     gazebo: GazeboExtensions = field(default_factory=GazeboExtensions)
     source: str = "<string>"
     urdf: str = field(default="", repr=False, compare=False)
+    warnings: tuple[str, ...] = field(default=(), compare=False)
+    """What urdfdom accepts but a user should hear about (one line each, naming the file)."""
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "links", MappingProxyType(dict(self.links)))

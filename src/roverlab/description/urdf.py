@@ -6,8 +6,16 @@ xacro first, with ``$(find pkg)`` resolved through the package path. The URDF is
 checked the way ``check_urdf`` (urdfdom) checks it, and every problem is one
 :class:`URDFError` line naming the file and the element: bad XML (with its line number), no
 ``<robot>``, a joint whose link does not exist, two roots, a cycle, duplicate names, a
-negative or NaN size, an unknown geometry or joint type, a revolute joint without limits, an
-undefined material, a Gazebo sensor on a missing link, a drive plugin naming a missing joint.
+negative or NaN size, an unknown geometry or joint type, a revolute joint without limits, a
+``<limit>`` without effort or velocity, a visual material without a name, a Gazebo sensor
+on a missing link, a drive plugin naming a missing joint.
+
+Materials follow urdfdom's rules exactly (docs/urdf.md lists them): the robot-level
+``<material>`` elements are known first, wherever they are; then, link by link in document
+order, each visual's material is the known one of that name if there is one (its own colour
+is then ignored), else the visual's own definition, which becomes known to every later link.
+A name used before any definition is accepted as urdfdom accepts it (a material without
+colour) and reported in :attr:`RobotModel.warnings`.
 """
 
 from __future__ import annotations
@@ -30,6 +38,7 @@ from roverlab.description.model import (
     JointDynamics,
     JointLimit,
     JointMimic,
+    JointSafety,
     JointType,
     Link,
     Material,
@@ -107,9 +116,9 @@ def _geometry(elem: ET.Element | None, ctx: _Ctx) -> Geometry:
     if elem is None:
         raise ctx.fail("no <geometry>")
     shapes = [c for c in elem if isinstance(c.tag, str)]
-    if len(shapes) != 1:
-        raise ctx.fail(f"<geometry> must hold exactly one shape, found {len(shapes)}")
-    shape = shapes[0]
+    if not shapes:
+        raise ctx.fail("<geometry> holds no shape (box, cylinder, sphere or mesh)")
+    shape = shapes[0]  # urdfdom reads the first child element only
     g = ctx.sub("<geometry>")
     if shape.tag == "box":
         return Box(_vec3(g.size(shape, "size", 3)))
@@ -133,8 +142,7 @@ def _material(elem: ET.Element, ctx: _Ctx) -> Material:
     color = elem.find("color")
     if color is not None:
         values = m.floats(color, "rgba", 4, None)
-        if not all(0.0 <= v <= 1.0 for v in values):
-            raise m.fail(f"<color rgba='{color.get('rgba')}'>: values must be in [0, 1]")
+        # urdfdom does not range-check colours; renderers clamp them
         rgba = (values[0], values[1], values[2], values[3])
     texture = elem.find("texture")
     tex = texture.get("filename") if texture is not None else None
@@ -160,6 +168,7 @@ def _link(
     elem: ET.Element,
     ctx: _Ctx,
     materials: dict[str, Material],
+    warnings: list[str],
 ) -> Link:
     name = elem.get("name", "")
     c = ctx.sub(f"<link name='{name}'>")
@@ -171,16 +180,25 @@ def _link(
         material = None
         m_elem = v.find("material")
         if m_elem is not None:
+            if m_elem.get("name") is None:
+                raise vc.fail(
+                    "<material> must have a name attribute (urdfdom: 'Visual material "
+                    "must contain a name attribute')"
+                )
             local = _material(m_elem, vc)
-            # As urdfdom: a robot-level material of that name wins; else a visual's own
-            # colour/texture defines it for the whole robot.
+            # urdfdom's assignMaterial: a known material of that name wins; else the
+            # visual's own one (even without colour) becomes known to every later link.
             material = materials.get(local.name)
             if material is None:
                 if local.rgba is None and local.texture is None:
-                    raise vc.fail(f"material '{local.name}' is not defined")
+                    warnings.append(
+                        vc.fail(
+                            f"material '{local.name}' is used before any definition: urdfdom "
+                            "gives it no colour and later definitions of that name are ignored"
+                        ).args[0]
+                    )
                 material = local
-                if local.name:
-                    materials[local.name] = local
+                materials[local.name] = local
         visuals.append(
             Visual(
                 origin=_origin(v.find("origin"), vc),
@@ -231,13 +249,12 @@ def _joint(elem: ET.Element, ctx: _Ctx) -> Joint:
     limit = None
     limit_elem = elem.find("limit")
     if limit_elem is not None:
-        lc = c.sub("<limit>")
-        needs = jtype in (JointType.REVOLUTE, JointType.PRISMATIC)
+        lc = c.sub("<limit>")  # urdfdom: effort and velocity always, lower/upper default 0
         limit = JointLimit(
             lower=lc.number(limit_elem, "lower", 0.0),
             upper=lc.number(limit_elem, "upper", 0.0),
-            effort=lc.number(limit_elem, "effort", None if needs else 0.0),
-            velocity=lc.number(limit_elem, "velocity", None if needs else 0.0),
+            effort=lc.number(limit_elem, "effort"),
+            velocity=lc.number(limit_elem, "velocity"),
         )
     elif jtype in (JointType.REVOLUTE, JointType.PRISMATIC):
         raise c.fail(f"a {jtype.value} joint needs <limit lower upper effort velocity>")
@@ -256,6 +273,21 @@ def _joint(elem: ET.Element, ctx: _Ctx) -> Joint:
     dyn = elem.find("dynamics")
     if dyn is not None:
         dynamics = JointDynamics(c.number(dyn, "damping", 0.0), c.number(dyn, "friction", 0.0))
+    safety = None
+    safe = elem.find("safety_controller")
+    if safe is not None:
+        sc = c.sub("<safety_controller>")
+        safety = JointSafety(
+            k_velocity=sc.number(safe, "k_velocity"),
+            soft_lower_limit=sc.number(safe, "soft_lower_limit", 0.0),
+            soft_upper_limit=sc.number(safe, "soft_upper_limit", 0.0),
+            k_position=sc.number(safe, "k_position", 0.0),
+        )
+    calibration = elem.find("calibration")
+    if calibration is not None:
+        for attr in ("rising", "falling"):
+            if calibration.get(attr) is not None:
+                c.sub("<calibration>").number(calibration, attr)
     return Joint(
         name=name,
         type=jtype,
@@ -266,6 +298,7 @@ def _joint(elem: ET.Element, ctx: _Ctx) -> Joint:
         limit=limit,
         mimic=mimic,
         dynamics=dynamics,
+        safety=safety,
     )
 
 
@@ -316,7 +349,13 @@ def parse_urdf(xml_text: str, *, source: str = "<string>") -> RobotModel:
     joint_elems = root.findall("joint")
     _unique("link", (e.get("name", "") for e in link_elems), ctx)
     _unique("joint", (e.get("name", "") for e in joint_elems), ctx)
-    links = {e.get("name", ""): _link(e, ctx, materials) for e in link_elems}
+    warnings: list[str] = []
+    for name_, mat in materials.items():
+        if mat.rgba is None and mat.texture is None:
+            warnings.append(
+                ctx.fail(f"<material name='{name_}'> has no <color> or <texture>").args[0]
+            )
+    links = {e.get("name", ""): _link(e, ctx, materials, warnings) for e in link_elems}
     joints = {e.get("name", ""): _joint(e, ctx) for e in joint_elems}
     gazebo = parse_gazebo(root.findall("gazebo"), source)
     model = RobotModel(
@@ -327,7 +366,20 @@ def parse_urdf(xml_text: str, *, source: str = "<string>") -> RobotModel:
         gazebo=gazebo,
         source=source,
         urdf=xml_text,
+        warnings=tuple(warnings),
     )
+    root_link = model.links[model.root_link]
+    if root_link.inertial is not None:  # robot_state_publisher's KDL parser warns so
+        object.__setattr__(
+            model,
+            "warnings",
+            (
+                *model.warnings,
+                f"{source}: the root link {root_link.name} has an inertia specified in the URDF, "
+                "but KDL does not support a root link with an inertia (add a dummy root link "
+                "such as base_footprint)",
+            ),
+        )
     _check_gazebo(model, ctx)
     return model
 
@@ -362,6 +414,7 @@ def robot_description(
     args: Mapping[str, str] | None = None,
     *,
     package_path: Iterable[str | os.PathLike[str]] = (),
+    xacro_ns: bool = False,
 ) -> str:
     """The URDF XML a launch file would put in the ``robot_description`` parameter.
 
@@ -376,11 +429,11 @@ def robot_description(
     if _is_xml(path_or_xml):
         text = str(path_or_xml)
         if "xmlns:xacro" in text:
-            return xacro_string(text, args=args, package_path=packages)
+            return xacro_string(text, args=args, package_path=packages, xacro_ns=xacro_ns)
         return text
     path = Path(path_or_xml)
     if path.suffix == ".xacro":
-        return xacro_file(path, args=args, package_path=packages)
+        return xacro_file(path, args=args, package_path=packages, xacro_ns=xacro_ns)
     try:
         text = path.read_text(encoding="utf-8")
     except OSError as err:
@@ -388,7 +441,7 @@ def robot_description(
     except UnicodeDecodeError as err:
         raise URDFError(f"{path}: not a UTF-8 text file") from err
     if "xmlns:xacro" in text:
-        return xacro_file(path, args=args, package_path=packages)
+        return xacro_file(path, args=args, package_path=packages, xacro_ns=xacro_ns)
     return text
 
 
@@ -397,6 +450,7 @@ def load_robot(
     *,
     args: Mapping[str, str] | None = None,
     package_path: Iterable[str | os.PathLike[str]] = (),
+    xacro_ns: bool = False,
 ) -> RobotModel:
     """Load a robot from a ``.urdf`` / ``.xacro`` / ``.urdf.xacro`` file or an XML string.
 
@@ -411,5 +465,5 @@ def load_robot(
         URDFError: the robot is not valid.
     """
     source = "<string>" if _is_xml(path_or_xml) else str(path_or_xml)
-    xml_text = robot_description(path_or_xml, args, package_path=package_path)
+    xml_text = robot_description(path_or_xml, args, package_path=package_path, xacro_ns=xacro_ns)
     return parse_urdf(xml_text, source=source)

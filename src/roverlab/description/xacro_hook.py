@@ -8,8 +8,17 @@ looks packages up in :class:`~roverlab.description.packages.PackagePath`. Everyt
 (properties, macros, ``xacro:arg`` / ``$(arg)``, includes relative to the including file,
 conditionals, in-order processing, the output formatting) is xacro's own.
 
-The hook point is pinned (:data:`XACRO_PINNED_VERSION`); :func:`check_xacro_hook` fails with
-a clear :class:`XacroError` if an upgrade moved it, and a test calls it.
+ROS 1's xacro (kinetic, melodic) also accepted the xacro tags without their ``xacro:``
+prefix (``<property>``, ``<macro>``, ``<include>``, ``<if>``, ``<unless>``, ``<arg>``,
+``<insert_block>``) and macro calls without it (``<robot_body/>``), with a deprecation
+warning; the 2.1 series (ROS 2) ignores them, so a ROS 1 robot expands to no links. Unless
+``xacro_ns=True`` (ROS 1's ``--xacro-ns``), :func:`_ros1_hooked` wraps ``xacro.eval_all``
+(to give un-prefixed xacro tags their prefix before xacro looks at them) and
+``xacro.handle_macro_call`` (to call a defined macro named without the prefix), and the
+expansion logs ROS 1's warning once, naming the file and the tag.
+
+The hook points are pinned (:data:`XACRO_PINNED_VERSION`); :func:`check_xacro_hook` fails
+with a clear :class:`XacroError` if an upgrade moved them, and a test calls it.
 """
 
 from __future__ import annotations
@@ -42,7 +51,22 @@ XACRO_PINNED_VERSION: Final = "2.1"
 """The xacro release series (major.minor) whose internals the hook relies on."""
 XACRO_HOOK: Final = ("xacro.substitution_args", "_eval_find")
 """Module and function replaced to resolve ``$(find pkg)``."""
-_XACRO_API: Final = ("process_file", "process_doc", "parse", "init_stacks", "XacroException")
+_XACRO_API: Final = (
+    "process_file",
+    "process_doc",
+    "parse",
+    "init_stacks",
+    "XacroException",
+    "eval_all",
+    "handle_macro_call",
+    "resolve_macro",
+)
+ROS1_TAGS: Final = frozenset(
+    {"property", "macro", "include", "if", "unless", "arg", "insert_block"}
+)
+"""xacro tags ROS 1's xacro accepted without the ``xacro:`` prefix (with a warning)."""
+ROS1_DEPRECATION: Final = "deprecated: xacro tags should be prepended with 'xacro' xml namespace."
+"""The warning ROS 1's xacro printed for an un-prefixed tag."""
 
 _LOCK = threading.RLock()  # xacro keeps its state in module globals
 _log = logging.getLogger("roverlab.description")
@@ -92,6 +116,67 @@ def _find_hooked(find: Callable[[str], str]) -> Iterator[None]:
         sa._eval_dict["find"] = old_eval
 
 
+def _ros1_include(node: Any) -> bool:
+    """ROS 1's rule: a plain ``<include>`` with child elements (Gazebo's ``<uri>``) is not
+    xacro's."""
+    return not any(c.nodeType == c.ELEMENT_NODE for c in node.childNodes)
+
+
+@contextlib.contextmanager
+def _ros1_hooked(deprecated: list[str]) -> Iterator[None]:
+    """Accept ROS 1's un-prefixed xacro tags and macro calls; record each use in
+    ``deprecated`` as ``"file: <tag>"``."""
+    eval_all, handle_macro_call = xacro.eval_all, xacro.handle_macro_call
+
+    def note(tag: str) -> None:
+        files = [str(f) for f in (xacro.filestack or []) if f]
+        deprecated.append(f"{files[-1] if files else '<string>'}: <{tag}>")
+
+    def rename(node: Any, tag: str) -> None:
+        note(tag)
+        node.tagName = node.nodeName = "xacro:" + tag
+
+    def ros1_eval_all(node: Any, macros: Any, symbols: Any) -> Any:
+        for child in node.childNodes:
+            if child.nodeType != child.ELEMENT_NODE or child.tagName not in ROS1_TAGS:
+                continue
+            if child.tagName != "include" or _ros1_include(child):
+                rename(child, child.tagName)
+        return eval_all(node, macros, symbols)
+
+    def ros1_macro_call(node: Any, macros: Any, symbols: Any) -> Any:
+        tag = node.tagName
+        if not tag.startswith("xacro:") and ":" not in tag:
+            try:
+                xacro.resolve_macro(tag, macros, symbols)
+            except (KeyError, TypeError, AttributeError):
+                pass  # not a macro: an ordinary element
+            else:
+                rename(node, tag)
+        return handle_macro_call(node, macros, symbols)
+
+    xacro.eval_all, xacro.handle_macro_call = ros1_eval_all, ros1_macro_call
+    try:
+        yield
+    finally:
+        xacro.eval_all, xacro.handle_macro_call = eval_all, handle_macro_call
+
+
+def _deprecation_line(uses: list[str]) -> str:
+    """ROS 1's warning, once, with the un-prefixed tags each file used."""
+    by_file: dict[str, list[str]] = {}
+    for use in uses:
+        file, _, tag = use.rpartition(": ")
+        tags = by_file.setdefault(file, [])
+        if tag not in tags:
+            tags.append(tag)
+    where = "; ".join(f"{f}: {', '.join(t)}" for f, t in by_file.items())
+    return (
+        f"{ROS1_DEPRECATION} Accepted as ROS 1's xacro (kinetic, melodic) did: {where} "
+        "(noetic's and ROS 2's xacro refuse them: write <xacro:NAME ...>)"
+    )
+
+
 def _where(label: str) -> str:
     """The file being processed when xacro failed (and the top file if different)."""
     files = [str(f) for f in (xacro.filestack or []) if f]
@@ -131,7 +216,11 @@ def _translate(err: Exception, label: str) -> XacroError:
 
 
 def _expand(
-    path: Path | None, text: str | None, args: Mapping[str, str], packages: PackagePath
+    path: Path | None,
+    text: str | None,
+    args: Mapping[str, str],
+    packages: PackagePath,
+    xacro_ns: bool = False,
 ) -> str:
     check_xacro_hook()
     label = str(path) if path is not None else "<string>"
@@ -140,10 +229,12 @@ def _expand(
         return str(packages.find(name))
 
     captured = io.StringIO()
+    deprecated: list[str] = []
+    ros1 = contextlib.nullcontext() if xacro_ns else _ros1_hooked(deprecated)
     with _LOCK:
         old_verbosity = xacro.verbosity
         try:
-            with _find_hooked(find), contextlib.redirect_stderr(captured):
+            with _find_hooked(find), ros1, contextlib.redirect_stderr(captured):
                 doc: Any
                 if path is not None:
                     doc = xacro.process_file(str(path), mappings=dict(args), verbosity=0)
@@ -167,6 +258,8 @@ def _expand(
     for line in captured.getvalue().splitlines():
         if line.strip():
             _log.warning("xacro: %s: %s", label, line.strip())
+    if deprecated:
+        _log.warning("xacro: %s", _deprecation_line(deprecated))
     return result
 
 
@@ -175,6 +268,7 @@ def xacro_file(
     *,
     args: Mapping[str, str] | None = None,
     package_path: PackagePath | None = None,
+    xacro_ns: bool = False,
 ) -> str:
     """Expand a xacro file: what ``xacro path name:=value ...`` prints.
 
@@ -182,6 +276,8 @@ def xacro_file(
         path: the ``.xacro`` / ``.urdf.xacro`` file.
         args: xacro arguments (``laser_visual:=true`` is ``{"laser_visual": "true"}``).
         package_path: where ``$(find pkg)`` looks (default: environment + bundled).
+        xacro_ns: ROS 1's ``--xacro-ns``: only ``xacro:``-prefixed tags are xacro's
+            (default: ROS 1's un-prefixed forms are accepted, with its warning).
 
     Returns:
         The expanded XML document, formatted as xacro writes it.
@@ -192,7 +288,7 @@ def xacro_file(
     p = Path(path)
     if not p.is_file():
         raise XacroError(f"{p}: no such file")
-    return _expand(p.resolve(), None, args or {}, package_path or PackagePath())
+    return _expand(p.resolve(), None, args or {}, package_path or PackagePath(), xacro_ns)
 
 
 def xacro_string(
@@ -200,10 +296,11 @@ def xacro_string(
     *,
     args: Mapping[str, str] | None = None,
     package_path: PackagePath | None = None,
+    xacro_ns: bool = False,
 ) -> str:
     """Expand a xacro document given as a string (relative includes resolve from the cwd).
 
     Raises:
         XacroError: one line naming the element or macro at fault.
     """
-    return _expand(None, xml_text, args or {}, package_path or PackagePath())
+    return _expand(None, xml_text, args or {}, package_path or PackagePath(), xacro_ns)

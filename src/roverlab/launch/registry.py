@@ -9,7 +9,6 @@ from __future__ import annotations
 import math
 import shlex
 from collections.abc import Callable
-from dataclasses import dataclass, field
 from importlib.metadata import entry_points
 from pathlib import Path
 from typing import Any
@@ -19,6 +18,8 @@ from roverlab.description import load_robot
 from roverlab.description.node import JointStatePublisher, RobotStatePublisher
 from roverlab.errors import RoverlabError
 from roverlab.geometry import quat_from_rpy
+from roverlab.launch.devices import DEVICE_NODES
+from roverlab.launch.state import LaunchState, NodeFactory
 from roverlab.launch.xml import LaunchError, NodeSpec
 from roverlab.localization.amcl.node import AmclNode
 from roverlab.localization.fake_localization import FakeLocalization
@@ -31,27 +32,12 @@ from roverlab.navigation.costmap.node import Costmap2DNode
 from roverlab.navigation.explore.node import Explore
 from roverlab.navigation.move_base.node import MoveBase
 from roverlab.viz.errors import DashboardError
-from roverlab.viz.launcher import start_rviz
+from roverlab.viz.joints import SLIDER_TOPIC
+from roverlab.viz.launcher import start_image_view, start_rviz
 from roverlab.world import BUNDLED_WORLDS, load_world
 
 __all__ = ["REGISTRY", "LaunchState", "NodeFactory", "register"]
 
-
-@dataclass
-class LaunchState:
-    """What the nodes of one launch share: the context, global parameters, and the
-    simulation being assembled (gzserver gives the world, spawn_model the robot)."""
-
-    context: Context
-    params: dict[str, Any]
-    world: Any = None
-    world_source: str = ""
-    spawns: list[tuple[Any, tuple[float, float, float], str]] = field(default_factory=list)
-    spawn_urdf: str = ""
-    warnings: list[str] = field(default_factory=list)
-
-
-NodeFactory = Callable[[LaunchState, NodeSpec], Node | None]
 
 REGISTRY: dict[tuple[str, str], NodeFactory] = {}
 
@@ -138,24 +124,52 @@ for _key in (
     ("robot_state_publisher", "state_publisher"),
 ):
     REGISTRY[_key] = _with_description(_make_rsp)
-for _key in (
-    ("joint_state_publisher", "joint_state_publisher"),
-    ("joint_state_publisher_gui", "joint_state_publisher_gui"),
-):
-    REGISTRY[_key] = _with_description(_make_jsp)
+
+
+def _make_jsp_gui(state: LaunchState, spec: NodeSpec, urdf: str) -> Node:
+    """joint_state_publisher_gui: joint_state_publisher that also follows the dashboard's
+    Joints sliders (their topic is added to its ``source_list``)."""
+    sources = list(spec.params.get("source_list") or [])
+    if SLIDER_TOPIC not in sources:
+        sources.append(SLIDER_TOPIC)
+    kwargs = {**_kwargs(spec), "parameter_overrides": {**spec.params, "source_list": sources}}
+    return JointStatePublisher(state.context, robot_description=urdf, node_name=spec.name, **kwargs)
+
+
+REGISTRY[("joint_state_publisher", "joint_state_publisher")] = _with_description(_make_jsp)
+REGISTRY[("joint_state_publisher_gui", "joint_state_publisher_gui")] = _with_description(
+    _make_jsp_gui
+)
 
 
 class StaticTransformPublisher(Node):
     """tf2_ros static_transform_publisher: ``x y z yaw pitch roll frame child`` or
     ``x y z qx qy qz qw frame child`` (ROS 1 order), latched on ``/tf_static``."""
 
-    def __init__(self, context: Context, *, args: str, source: str, **kwargs: Any) -> None:
+    def __init__(
+        self, context: Context, *, args: str, source: str, pkg: str = "tf2_ros", **kwargs: Any
+    ) -> None:
         super().__init__(
             kwargs.pop("node_name", "static_transform_publisher"), context=context, **kwargs
         )
         parts = shlex.split(args)
-        if len(parts) in (9, 10):  # ROS 1 tf's trailing period in ms
-            parts = parts[:8] if len(parts) == 9 else parts[:9]
+        if pkg == "tf":  # ROS 1 tf: a trailing period in ms (republished; latched here)
+            if len(parts) not in (9, 10):
+                raise LaunchError(
+                    f"{source}: tf/static_transform_publisher needs 'x y z yaw pitch roll "
+                    f"frame child period_in_ms' or 'x y z qx qy qz qw frame child "
+                    f"period_in_ms', got {args!r}"
+                )
+            try:
+                period = float(parts[-1])
+            except ValueError:
+                period = float("nan")
+            if not period > 0:
+                raise LaunchError(
+                    f"{source}: tf/static_transform_publisher: period_in_ms {parts[-1]!r} "
+                    "must be a positive number"
+                )
+            parts = parts[:-1]
         if len(parts) not in (8, 9):
             raise LaunchError(
                 f"{source}: static_transform_publisher needs 'x y z yaw pitch roll frame child' "
@@ -196,7 +210,12 @@ class StaticTransformPublisher(Node):
 
 def _static_tf(state: LaunchState, spec: NodeSpec) -> Node:
     return StaticTransformPublisher(
-        state.context, args=spec.args, source=spec.source, node_name=spec.name, **_kwargs(spec)
+        state.context,
+        args=spec.args,
+        source=spec.source,
+        pkg=spec.pkg,
+        node_name=spec.name,
+        **_kwargs(spec),
     )
 
 
@@ -321,10 +340,42 @@ def _rviz(state: LaunchState, spec: NodeSpec) -> Node | None:
         raise LaunchError(f"{spec.source}: rviz: {err}") from err
 
 
-REGISTRY[("rqt_image_view", "rqt_image_view")] = _unavailable(
-    "open `roverlab dashboard` in another terminal: it has the image panel"
+_NO_JOYSTICK = (
+    "no joystick here: roverlab reads no /dev/input devices; drive with `roverlab teleop` "
+    "(the keyboard, as teleop_twist_keyboard) or publish /cmd_vel"
 )
+for _key in (
+    ("joy", "joy_node"),
+    ("joy", "joy"),
+    ("teleop_twist_joy", "teleop_node"),
+    ("teleop_twist_joy", "teleop_twist_joy"),
+    ("turtlebot_teleop", "turtlebot_teleop_joy"),
+):
+    REGISTRY[_key] = _unavailable(_NO_JOYSTICK)
+
+
+@register("rqt_image_view", "rqt_image_view")
+def _rqt_image_view(state: LaunchState, spec: NodeSpec) -> Node | None:
+    """The dashboard's image panel (``args`` or ``<remap from="image">`` names the topic)."""
+    try:
+        return start_image_view(
+            state.context,
+            spec.args,
+            remaps=spec.remaps,
+            node_name=spec.name,
+            source=spec.source,
+            warn=state.warnings.append,
+        )
+    except DashboardError as err:
+        raise LaunchError(f"{spec.source}: rqt_image_view: {err}") from err
+
+
 for _t in ("teleop_twist_keyboard.py", "teleop_twist_keyboard"):
     REGISTRY[("teleop_twist_keyboard", _t)] = _unavailable(
         "it needs a terminal: run `roverlab teleop` in one"
     )
+
+for _key, _factory in DEVICE_NODES.items():
+    if _key in REGISTRY:
+        raise LaunchError(f"node {_key[0]}/{_key[1]} is registered twice")
+    REGISTRY[_key] = _factory

@@ -13,11 +13,13 @@ from pathlib import Path
 
 from roverlab.core import Context, Node, QoSProfile
 from roverlab.core.log import log_to_file
+from roverlab.description.check import robot_warnings
 from roverlab.launch.registry import REGISTRY, LaunchState
 from roverlab.launch.xml import LaunchError, LaunchSpec, NodeSpec, load_launch
 from roverlab.msgs import classes as mc
 from roverlab.sim.node import SimulatorNode, SpawnPose
 from roverlab.sim.robot import sim_config_from_model
+from roverlab.world import world_warnings
 
 __all__ = ["Launch", "build_launch"]
 
@@ -140,6 +142,11 @@ class Launch:
         if node_spec.fq_name in self.running and not self.context.is_shutdown():
             self.died(node_spec, "it ended")
 
+    world_warnings: list[str] = field(default_factory=list)
+    """The Gazebo world's warnings, grouped (models and meshes not found, ...)."""
+    robot_warnings: list[str] = field(default_factory=list)
+    """The spawned robot's warnings (urdfdom's, unsupported plugins and sensors)."""
+
 
 def build_launch(
     path: str | Path | LaunchSpec,
@@ -171,6 +178,7 @@ def build_launch(
         if len(state.spawns) > 1:
             raise LaunchError(f"{state.spawns[1][2]}: one robot per simulation is supported")
         robot, (x, y, yaw), _ = state.spawns[0]
+        launch.robot_warnings = robot_warnings(robot)
         launch.simulator = SimulatorNode(
             context=context,
             scene=state.world.to_scene(),
@@ -190,5 +198,7 @@ def build_launch(
             launch.nodes.append(holder)
     elif state.world is not None:
         state.warnings.append(f"{state.world_source}: a world without a spawned robot")
+    if state.world is not None:
+        launch.world_warnings = world_warnings(state.world)
     launch.warnings = state.warnings
     return launch

@@ -54,6 +54,7 @@ class NodeSpec:
     respawn_delay: float = 0.0  # wall seconds
     required: bool = False
     env: dict[str, str] = field(default_factory=dict)  # <env> of its scope
+    clear_params: bool = False
 
     @property
     def fq_name(self) -> str:
@@ -318,6 +319,14 @@ class _Reader:
             else:
                 raise LaunchError(f"{_where(scope, child)}: not allowed inside <node>")
         node.params = {k.lstrip("/"): v for k, v in node.params.items()}
+        # clear_params="true": roslaunch empties the node's private namespace on the
+        # parameter server before it sets this launch's parameters. roverlab keeps no
+        # parameters between launches, so a node's private parameters are always this
+        # launch's only: the attribute is checked and holds already.
+        clear = self.attr(elem, "clear_params", scope, "false").lower()
+        if clear not in ("true", "false", "1", "0"):
+            raise LaunchError(f"{_where(scope, elem)}: clear_params must be true or false")
+        node.clear_params = clear in ("true", "1")
         self.spec.nodes.append(node)
 
     def on_process_attrs(self, elem: ET.Element, scope: _Scope, node: NodeSpec) -> None:
@@ -399,15 +408,9 @@ class _Reader:
             argv = shlex.split(command)
         except ValueError as err:
             raise LaunchError(f"{_where(scope, elem)}: cannot parse command: {err}") from err
-        if argv and Path(argv[0]).name in ("xacro", "xacro.py"):
-            files = [a for a in argv[1:] if not a.startswith("-") and ":=" not in a]
-            mappings = dict(a.split(":=", 1) for a in argv[1:] if ":=" in a)
-            if len(files) != 1:
-                raise LaunchError(f"{_where(scope, elem)}: xacro command needs one input file")
-            try:
-                return robot_description(Path(files[0]), mappings, package_path=self.package_path)
-            except DescriptionError as err:
-                raise LaunchError(f"{_where(scope, elem)}: {err}") from err
+        xacro_argv = _xacro_argv(argv)
+        if xacro_argv is not None:
+            return self._xacro(xacro_argv, scope, elem)
         try:
             done = subprocess.run(command, shell=True, capture_output=True, text=True, check=False)
         except OSError as err:
@@ -416,6 +419,53 @@ class _Reader:
             first = (done.stderr.strip().splitlines() or ["no output"])[0]
             raise LaunchError(f"{_where(scope, elem)}: command exited {done.returncode}: {first}")
         return done.stdout
+
+    def _xacro(self, argv: list[str], scope: _Scope, elem: ET.Element) -> str:
+        """ROS 1's xacro command line: ``--inorder`` / ``-i`` (the default since melodic,
+        accepted and ignored), ``--xacro-ns``, ``-o FILE`` (the output is the parameter
+        anyway), ``name:=value`` mappings and one input file."""
+        files: list[str] = []
+        mappings: dict[str, str] = {}
+        xacro_ns = False
+        skip = False
+        for a in argv:
+            if skip:
+                skip = False
+            elif a in ("--inorder", "-i", "--legacy", "--check-order"):
+                continue
+            elif a == "--xacro-ns":
+                xacro_ns = True
+            elif a in ("-o", "--output"):
+                skip = True
+            elif ":=" in a:
+                name, value = a.split(":=", 1)
+                mappings[name] = value
+            elif a.startswith("-"):
+                raise LaunchError(f"{_where(scope, elem)}: xacro option {a!r} is not supported")
+            else:
+                files.append(a)
+        if len(files) != 1:
+            raise LaunchError(f"{_where(scope, elem)}: xacro command needs one input file")
+        try:
+            return robot_description(
+                Path(files[0]), mappings, package_path=self.package_path, xacro_ns=xacro_ns
+            )
+        except DescriptionError as err:
+            raise LaunchError(f"{_where(scope, elem)}: {err}") from err
+
+
+def _xacro_argv(argv: list[str]) -> list[str] | None:
+    """The xacro arguments of a ``command=`` running xacro in any of ROS 1's spellings
+    (``xacro``, ``xacro.py``, ``$(find xacro)/xacro[.py]``, ``python[3] .../xacro.py``,
+    ``rosrun xacro xacro[.py]``), else ``None``."""
+    rest = list(argv)
+    if rest and Path(rest[0]).name in ("python", "python2", "python3"):
+        rest = rest[1:]
+    if len(rest) >= 3 and rest[0] == "rosrun" and rest[1] == "xacro":
+        rest = rest[2:]
+    if rest and Path(rest[0]).name in ("xacro", "xacro.py"):
+        return rest[1:]
+    return None
 
 
 def _join(ns: str, name: str) -> str:

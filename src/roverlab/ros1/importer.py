@@ -1,6 +1,6 @@
 """The import hook that lets a ROS 1 script's imports resolve without ROS.
 
-* ``rospy``, ``actionlib``, ``roslib``, ``tf`` (and their submodules) are roverlab's
+* ``rospy``, ``actionlib``, ``roslib``, ``tf``, ``cv_bridge`` (and submodules) are roverlab's
   compatibility modules (:mod:`roverlab.ros1.rospy`, ...);
 * ``<pkg>.msg`` and ``<pkg>.srv`` are :class:`~roverlab.ros1.messages.InterfaceModule`\\ s
   for any package the type store knows (``geometry_msgs``, ``move_base_msgs``, ...) or that
@@ -36,6 +36,7 @@ COMPAT_MODULES: Final = {
     "actionlib": "roverlab.ros1.actionlib",
     "roslib": "roverlab.ros1.roslib",
     "tf": "roverlab.ros1.tf",
+    "cv_bridge": "roverlab.ros1.cv_bridge",
 }
 _KINDS: Final = ("msg", "srv")
 

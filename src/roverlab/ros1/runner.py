@@ -24,6 +24,42 @@ def _exit_code(code: object) -> int:
     return 1
 
 
+_PY2_HINTS = (
+    ("Missing parentheses in call to 'print'", "a print statement: write print(...)"),
+    ("Missing parentheses in call to 'exec'", "an exec statement: write exec(...)"),
+    ("leading zeros in decimal integer", "an octal literal like 0777: write 0o777"),
+    ("multiple exception types must be parenthesized", "'except E, e:': write 'except E as e:'"),
+)
+
+
+def python2_problem(path: Path) -> str | None:
+    """One line naming the file, the line and the Python 3 fix if ``path`` is Python 2 code
+    (or does not compile at all), else ``None``."""
+    try:
+        source = path.read_bytes()
+    except OSError as err:
+        return f"{path}: cannot read: {err.strerror or err}"
+    try:
+        compile(source, str(path), "exec")
+    except SyntaxError as err:
+        msg = err.msg or "invalid syntax"
+        text = (err.text or "").strip()
+        where = f"{path}:{err.lineno}"
+        for needle, fix in _PY2_HINTS:
+            if needle in msg:
+                return f"{where}: Python 2 code, {fix} (roverlab runs Python 3, as ROS noetic)"
+        if text.startswith(("print ", "print>>")):
+            return f"{where}: Python 2 code, a print statement: write print(...) (Python 3)"
+        if "`" in text:
+            return f"{where}: Python 2 code, backquotes: write repr(...) (Python 3)"
+        if "<>" in text:
+            return f"{where}: Python 2 code, '<>': write '!=' (Python 3)"
+        if text.startswith("raise ") and "," in text:
+            return f"{where}: Python 2 code, 'raise E, msg': write 'raise E(msg)' (Python 3)"
+        return f"{where}: {msg}: {text}"
+    return None
+
+
 def run_script(path: str | os.PathLike[str], argv: list[str], context: Context) -> int:
     """Run ``path`` as ``__main__`` with ``sys.argv = [path, *argv]`` on ``context``.
 
@@ -36,6 +72,10 @@ def run_script(path: str | os.PathLike[str], argv: list[str], context: Context) 
         (its traceback printed, as ``python SCRIPT.py`` would), 130 after a second Ctrl-C.
     """
     script = Path(path)
+    problem = python2_problem(script)
+    if problem is not None:
+        print(f"error: {problem}", file=sys.stderr)
+        return 1
     install()
     RUNTIME.configure(context, list(argv))
     old_argv, old_path = sys.argv, list(sys.path)

@@ -4,22 +4,22 @@
 the :class:`~roverlab.viz.config.DashboardConfig` and one :class:`DisplayState` per display
 (its subscription, its newest frame, its status). Subscription callbacks run on the
 executor thread and only store the newest data with a version number; the web server's
-threads read snapshots and compare versions, so each client gets only what changed.
-Configuration changes from the page are applied on the executor thread
-(:meth:`VizBridge.set_config`).
+threads read snapshots and compare versions, so each client gets only what changed. What a
+message becomes is each display type's own handler (:mod:`roverlab.viz.handlers`, one per
+display, as rviz has one plugin per display). Configuration changes from the page are
+applied on the executor thread (:meth:`VizBridge.set_config`).
 """
 
 from __future__ import annotations
 
 import io
-import json
 import math
 import re
 import threading
 import time
 from collections import deque
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Final
 
@@ -32,14 +32,13 @@ from roverlab.errors import RoverlabError
 from roverlab.geometry import Transform3, yaw_from_quat
 from roverlab.maps import save_map
 from roverlab.msgs import (
+    JointState,
     PointStamped,
     PoseStamped,
     PoseWithCovarianceStamped,
     image_to_array,
     occupancy_grid_to_array,
-    pointcloud2_to_xyz,
     pose_from_xytheta,
-    scan_to_points,
     stamp_to_msg,
     yaw_from_quaternion,
 )
@@ -55,26 +54,19 @@ from roverlab.viz.config import (
 from roverlab.viz.displays import (
     MarkerStore,
     PoseTrail,
-    color_buckets,
-    decimate,
-    map_change,
-    pose_covariance_primitives,
-    poses_in_fixed,
 )
 from roverlab.viz.errors import DashboardError
+from roverlab.viz.handlers import HANDLERS, DisplayState, Versioned, markers_changed
+from roverlab.viz.joints import SLIDER_TOPIC, JointSliders
 from roverlab.viz.protocol import (
     INITIALPOSE_COVARIANCE,
     VisualOutline,
     colorize,
     encode_image,
     encode_image_file,
-    encode_map,
-    encode_map_patch,
-    encode_path,
-    encode_points,
-    encode_poses,
     image_to_rgb8,
     robot_outlines,
+    robot_shapes,
 )
 
 __all__ = [
@@ -113,14 +105,6 @@ class RvizNode(Node):
 
 
 @dataclass(frozen=True)
-class Versioned:
-    """A payload and the version it belongs to (versions only grow)."""
-
-    version: int
-    payload: Any
-
-
-@dataclass(frozen=True)
 class TopicInfo:
     """One topic of the running system, as the topic list shows it."""
 
@@ -130,60 +114,12 @@ class TopicInfo:
     subscribers: int
 
 
-@dataclass
-class DisplayState:
-    """What one display has: its config, subscription, newest frame and status.
-
-    Attributes:
-        slot: index in the configuration (the server writes it into the frames' header,
-            which are stored with slot 0, so a reordered configuration re-uses them).
-        config: the display's configuration.
-        frame: newest binary frame (for markers: the JSON text of the primitive list).
-        map_base: a map display's last full frame; ``map_patches`` follow it.
-        status: status-tree rows ``name -> (level, text)``, level ``ok|warn|error``.
-        received: messages received since subscribing.
-        info: small per-display data for the JSON state (e.g. a map's frame).
-    """
-
-    slot: int
-    config: DisplayConfig
-    frame: Versioned | None = None
-    map_base: Versioned | None = None
-    map_patches: list[Versioned] = field(default_factory=list)
-    map_cells: Any = None
-    map_key: tuple[Any, ...] = ()
-    map_msg: Any = None
-    status: dict[str, tuple[str, str]] = field(default_factory=dict)
-    received: int = 0
-    info: dict[str, Any] = field(default_factory=dict)
-    sub: Any = None
-    sub_key: tuple[str, str] = ("", "")
-    trail: PoseTrail | None = None
-    markers: MarkerStore | None = None
-    image_msg: Versioned | None = None
-    image_jpeg: Versioned | None = None
-    error: str | None = None
-
-    @property
-    def kind(self) -> str:
-        return self.config.kind
-
-
 def _xyyaw(t: Transform3) -> list[float]:
     return [
         round(t.translation[0], 4),
         round(t.translation[1], 4),
         round(yaw_from_quat(t.rotation), 4),
     ]
-
-
-def _stamp_time(header: Any) -> Time:
-    return Time(int(header.stamp.sec) * 1_000_000_000 + int(header.stamp.nanosec))
-
-
-def _rgb(config: DisplayConfig) -> tuple[int, int, int]:
-    c = config.option("color")
-    return int(c[0]), int(c[1]), int(c[2])
 
 
 class VizBridge:
@@ -227,6 +163,9 @@ class VizBridge:
         self._received: dict[str, int] = {}
         self._rate_samples: dict[str, deque[tuple[float, int]]] = {}
         self.outlines: Versioned | None = None
+        self.shapes: list[dict[str, Any]] = []
+        self.joint_sliders: JointSliders | None = None
+        self._slider_pub: Any = None
         self._description_sub: Any = None
         self._description_topic = ""
         self.config = config if config is not None else default_config(fixed_frame)
@@ -247,7 +186,7 @@ class VizBridge:
         self._apply(self.config)
 
     # ------------------------------------------------------------------ state
-    def _next(self) -> int:
+    def next_version(self) -> int:
         with self._lock:
             self._version += 1
             return self._version
@@ -266,10 +205,10 @@ class VizBridge:
         return "odom"
 
     def _lookup(self, frame: str, stamp: Time | None = None) -> Transform3 | None:
-        tf, _ = self._lookup_why(frame, stamp)
+        tf, _ = self.lookup_why(frame, stamp)
         return tf
 
-    def _lookup_why(self, frame: str, stamp: Time | None = None) -> tuple[Transform3 | None, str]:
+    def lookup_why(self, frame: str, stamp: Time | None = None) -> tuple[Transform3 | None, str]:
         fixed = self.fixed_frame
         frame = frame.lstrip("/")
         if not frame:
@@ -356,6 +295,7 @@ class VizBridge:
             self._description_sub = None
         self._description_topic = topic
         self.outlines = None
+        self.shapes = []
         if topic:
             self._description_sub = self.node.create_subscription(
                 "std_msgs/msg/String", topic, self._on_description, _LATCHED
@@ -364,21 +304,7 @@ class VizBridge:
     def _subscribe(self, state: DisplayState, key: tuple[str, str]) -> Any:
         topic, typename = key
         kind = state.kind
-        handlers: dict[str, Callable[[DisplayState, Any], None]] = {
-            "map": self._on_map,
-            "laser_scan": self._on_scan,
-            "point_cloud2": self._on_cloud,
-            "odometry": self._on_odom,
-            "path": self._on_path,
-            "pose_array": self._on_pose_array,
-            "pose": self._on_pose,
-            "pose_with_covariance": self._on_pose_with_covariance,
-            "polygon": self._on_polygon,
-            "marker": self._on_marker,
-            "marker_array": self._on_marker_array,
-            "image": self._on_image,
-        }
-        handler = handlers[kind]
+        handler = HANDLERS[kind](self)
 
         def callback(msg: Any) -> None:
             if state.sub_key != key:
@@ -386,7 +312,7 @@ class VizBridge:
             state.received += 1
             self._received[topic] = self._received.get(topic, 0) + 1
             try:
-                handler(state, msg)
+                handler.on_message(state, msg)
                 state.error = None
             except (RoverlabError, ValueError, OSError) as err:
                 state.error = f"{type(err).__name__}: {err}"
@@ -395,193 +321,30 @@ class VizBridge:
         return self.node.create_subscription(typename, topic, callback, qos)
 
     # -------------------------------------------------------------- callbacks
-    def _tf_status(self, state: DisplayState, tf: Transform3 | None, why: str) -> bool:
-        if tf is None:
-            state.status["Transform"] = ("error", why)
-            return False
-        state.status["Transform"] = ("ok", "Transform OK")
-        return True
-
-    def _on_map(self, state: DisplayState, msg: Any) -> None:
-        state.map_msg = msg
-        cells = occupancy_grid_to_array(msg)
-        o = msg.info.origin
-        origin = (float(o.position.x), float(o.position.y), yaw_from_quaternion(o.orientation))
-        res = float(msg.info.resolution)
-        frame_id = str(msg.header.frame_id).lstrip("/") or "map"
-        key = (cells.shape, res, origin, frame_id)
-        height, width = cells.shape
-        state.info = {"frame": frame_id, "width": int(width), "height": int(height)}
-        prev = state.map_cells
-        if state.map_base is not None and key == state.map_key and prev is not None:
-            change = map_change(prev, cells)
-            if change is None:
-                return
-            x0, y0, window = change
-            if len(state.map_patches) < _MAX_PATCHES and window.size * 2 < cells.size:
-                state.map_cells = cells
-                patch = Versioned(self._next(), encode_map_patch(window, x0, y0))
-                state.map_patches = [*state.map_patches, patch]
-                state.frame = patch
-                return
-        frame = Versioned(self._next(), encode_map(cells, resolution_m=res, origin=origin))
-        state.map_cells = cells
-        state.map_key = key
-        state.map_patches = []
-        state.map_base = frame
-        state.frame = frame
-
-    def _on_scan(self, state: DisplayState, msg: Any) -> None:
-        cfg = state.config
-        tf, why = self._lookup_why(str(msg.header.frame_id), _stamp_time(msg.header))
-        if not self._tf_status(state, tf, why):
-            return
-        assert tf is not None
-        pts = scan_to_points(msg)
-        world = tf.apply(np.column_stack((pts, np.zeros(len(pts)))))[:, :2]
-        values = None
-        if cfg.option("color_transformer") == "Intensity" and len(msg.intensities) > 0:
-            rng = np.asarray(msg.ranges, dtype=np.float64)
-            ok = np.isfinite(rng) & (rng >= msg.range_min) & (rng <= msg.range_max)
-            inten = np.asarray(msg.intensities, dtype=np.float64)
-            if len(inten) == len(rng):
-                values = inten[ok]
-        idx, palette = color_buckets(
-            str(cfg.option("color_transformer")),
-            count=len(world),
-            flat_rgb=_rgb(cfg),
-            alpha=float(cfg.option("alpha")),
-            values=values if values is not None and len(values) == len(world) else None,
-        )
-        state.frame = Versioned(self._next(), encode_points(world, idx, palette))
-
-    def _on_cloud(self, state: DisplayState, msg: Any) -> None:
-        cfg = state.config
-        tf, why = self._lookup_why(str(msg.header.frame_id), _stamp_time(msg.header))
-        if not self._tf_status(state, tf, why):
-            return
-        assert tf is not None
-        xyz = pointcloud2_to_xyz(msg, skip_nans=True)
-        xyz = decimate(xyz, int(cfg.option("max_points")))
-        world = tf.apply(xyz.astype(np.float64))
-        idx, palette = color_buckets(
-            str(cfg.option("color_transformer")),
-            count=len(world),
-            flat_rgb=_rgb(cfg),
-            alpha=float(cfg.option("alpha")),
-            values=world[:, 2],
-        )
-        state.info = {"points": len(world)}
-        state.frame = Versioned(self._next(), encode_points(world[:, :2], idx, palette))
-
-    def _posed(self, state: DisplayState, header: Any, poses: Sequence[Any]) -> np.ndarray | None:
-        tf, why = self._lookup_why(str(header.frame_id), _stamp_time(header))
-        if not self._tf_status(state, tf, why):
-            return None
-        assert tf is not None
-        pos = np.array([(p.position.x, p.position.y, p.position.z) for p in poses], dtype=float)
-        quat = np.array(
-            [(p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w) for p in poses],
-            dtype=float,
-        )
-        return poses_in_fixed(tf, pos.reshape(-1, 3), quat.reshape(-1, 4))
-
-    def _on_odom(self, state: DisplayState, msg: Any) -> None:
-        arr = self._posed(state, msg.header, [msg.pose.pose])
-        if arr is None or state.trail is None:
-            return
-        if state.trail.add(float(arr[0, 0]), float(arr[0, 1]), float(arr[0, 2])):
-            state.frame = Versioned(self._next(), encode_poses(state.trail.array()))
-
-    def _on_path(self, state: DisplayState, msg: Any) -> None:
-        arr = self._posed(state, msg.header, [p.pose for p in msg.poses])
-        if arr is None:
-            return
-        state.frame = Versioned(self._next(), encode_path(arr[:, :2]))
-
-    def _on_pose_array(self, state: DisplayState, msg: Any) -> None:
-        arr = self._posed(state, msg.header, list(msg.poses))
-        if arr is None:
-            return
-        state.frame = Versioned(self._next(), encode_poses(arr))
-
-    def _on_pose(self, state: DisplayState, msg: Any) -> None:
-        arr = self._posed(state, msg.header, [msg.pose])
-        if arr is not None:
-            state.frame = Versioned(self._next(), encode_poses(arr))
-
-    def _on_pose_with_covariance(self, state: DisplayState, msg: Any) -> None:
-        """/amcl_pose: the arrow, the position covariance ellipse (turned into the fixed
-        frame) and the yaw wedge, sent as marker primitives."""
-        tf, why = self._lookup_why(str(msg.header.frame_id), _stamp_time(msg.header))
-        if not self._tf_status(state, tf, why):
-            return
-        assert tf is not None
-        p = msg.pose.pose
-        q = (p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w)
-        pose = poses_in_fixed(tf, np.array([[p.position.x, p.position.y, p.position.z]]),
-                              np.array([q]))[0]  # fmt: skip
-        cov = np.asarray(msg.pose.covariance, dtype=np.float64).reshape(6, 6)
-        rot = tf.yaw
-        r = np.array([[math.cos(rot), -math.sin(rot)], [math.sin(rot), math.cos(rot)]])
-        cfg = state.config
-        items = pose_covariance_primitives(
-            (float(pose[0]), float(pose[1]), float(pose[2])), r @ cov[:2, :2] @ r.T,
-            float(cov[5, 5]), rgb=_rgb(cfg), alpha=float(cfg.option("alpha")),
-            length=float(cfg.option("length")), scale=float(cfg.option("covariance_scale")),
-        )  # fmt: skip
-        state.frame = Versioned(self._next(), json.dumps(items))
-
-    def _on_polygon(self, state: DisplayState, msg: Any) -> None:
-        """rviz's Polygon display (a footprint): the closed outline, as a marker line."""
-        tf, why = self._lookup_why(str(msg.header.frame_id), _stamp_time(msg.header))
-        if not self._tf_status(state, tf, why):
-            return
-        assert tf is not None
-        pts = np.array([[p.x, p.y, p.z] for p in msg.polygon.points], dtype=np.float64)
-        items: list[dict[str, Any]] = []
-        if len(pts):
-            xy = tf.apply(pts)[:, :2].round(4).tolist()
-            r, g, b = _rgb(state.config)
-            rgba = [r / 255.0, g / 255.0, b / 255.0, float(state.config.option("alpha"))]
-            items.append({"shape": "polyline", "rgba": rgba, "width": 0.0,
-                          "points": [*xy, xy[0]]})  # fmt: skip
-        state.frame = Versioned(self._next(), json.dumps(items))
-
-    def _markers_changed(self, state: DisplayState) -> None:
-        assert state.markers is not None
-        state.frame = Versioned(self._next(), json.dumps(state.markers.primitives()))
-        errors = state.markers.errors
-        if errors:
-            name, why = next(iter(errors.items()))
-            state.status["Transform"] = ("error", f"marker {name}: {why}")
-        else:
-            state.status["Transform"] = ("ok", "Transform OK")
-
     def _refresh_markers(self) -> None:
         now_ns = self.context.now().nanoseconds
         for d in self.displays:
             if d.markers is not None and d.markers.refresh(now_ns):
-                self._markers_changed(d)
-
-    def _on_marker(self, state: DisplayState, msg: Any) -> None:
-        assert state.markers is not None
-        state.markers.add(msg, self.context.now().nanoseconds)
-        self._markers_changed(state)
-
-    def _on_marker_array(self, state: DisplayState, msg: Any) -> None:
-        assert state.markers is not None
-        now = self.context.now().nanoseconds
-        for m in msg.markers:
-            state.markers.add(m, now)
-        self._markers_changed(state)
-
-    def _on_image(self, state: DisplayState, msg: Any) -> None:
-        state.image_msg = Versioned(self._next(), msg)
+                markers_changed(self, d)
 
     def _on_description(self, msg: Any) -> None:
         model = parse_urdf(str(msg.data), source=self._description_topic)
-        self.outlines = Versioned(self._next(), robot_outlines(model))
+        self.shapes = [shape.to_dict() for shape in robot_shapes(model)]
+        self.outlines = Versioned(self.next_version(), robot_outlines(model))
+        self.joint_sliders = JointSliders(model)
+
+    def set_joint(self, name: str, position: float) -> None:
+        """Move a joint slider and publish every slider on the sliders topic.
+
+        Raises:
+            KeyError: no robot description yet, or no such joint.
+        """
+        if self.joint_sliders is None:
+            raise KeyError("no robot description: no joints to move")
+        self.joint_sliders.set(name, position)
+        if self._slider_pub is None:
+            self._slider_pub = self.node.create_publisher(JointState, SLIDER_TOPIC, 10)
+        self._slider_pub.publish(self.joint_sliders.message(self.node.get_clock().now().to_msg()))
 
     # ---------------------------------------------------------------- queries
     def refresh_remote_graph(self) -> None:
@@ -697,10 +460,12 @@ class VizBridge:
         """Small per-tick state: frames, robot outline, per-display info and status."""
         fixed = self.fixed_frame
         frames: dict[str, list[float]] = {}
+        frames3: dict[str, list[float]] = {}
         for name in self.tf_buffer.frames():
             tf = self._lookup(name)
             if tf is not None:
                 frames[name] = _xyyaw(tf)
+                frames3[name] = [round(float(v), 5) for v in (*tf.translation, *tf.rotation)]
         robot: list[dict[str, Any]] = []
         outlines: list[VisualOutline] = self.outlines.payload if self.outlines else []
         for outline in outlines:
@@ -716,6 +481,9 @@ class VizBridge:
             "fixed_frame": fixed,
             "frames": frames,
             "robot": robot,
+            "frames3": frames3,
+            "robot3d": self.shapes,
+            "joints": self.joint_sliders.to_list() if self.joint_sliders else [],
             "displays": [d.info for d in self.displays],
             "status": self.status(frames, outlines),
             "image_topics": self.image_topics(),

@@ -14,9 +14,10 @@ import typer
 from roverlab.cli.common import Connection, network_options
 from roverlab.viz.config import DashboardConfig, default_config, load_config
 from roverlab.viz.errors import DashboardError
+from roverlab.viz.launcher import image_view_config
 from roverlab.viz.server import DashboardServer
 
-__all__ = ["dashboard", "load_dashboard_config"]
+__all__ = ["dashboard", "image_view", "load_dashboard_config"]
 
 
 def load_dashboard_config(path: Path | None, fixed_frame: str | None) -> DashboardConfig | None:
@@ -72,6 +73,18 @@ def dashboard(
 ) -> None:
     """Serve a web rviz (displays, tools, camera, drive) for the running system."""
     config = load_dashboard_config(rviz, fixed_frame)
+    _serve(ctx, host, port, token, config, save_config, map_dir)
+
+
+def _serve(
+    ctx: typer.Context,
+    host: str,
+    port: int,
+    token: str | None,
+    config: DashboardConfig | None,
+    save_config: Path | None,
+    map_dir: Path,
+) -> None:
     with Connection(network_options(ctx)) as conn:
         server = DashboardServer(
             conn.context,
@@ -93,3 +106,24 @@ def dashboard(
             pass
         finally:
             server.stop()
+
+
+def image_view(
+    ctx: typer.Context,
+    topic: Annotated[
+        str | None,
+        typer.Argument(
+            help="Image topic (sensor_msgs/Image or CompressedImage), e.g. "
+            "/usb_cam/image_raw; omitted: pick one in the page."
+        ),
+    ] = None,
+    host: Annotated[
+        str, typer.Option("--host", help="Address to bind; non-loopback needs a token.")
+    ] = "127.0.0.1",
+    port: Annotated[int, typer.Option("--port", help="TCP port to serve on.")] = 8080,
+    token: Annotated[
+        str | None, typer.Option("--token", help="Access token (made up for non-loopback).")
+    ] = None,
+) -> None:
+    """rqt_image_view: the dashboard with its image panel on TOPIC."""
+    _serve(ctx, host, port, token, image_view_config(topic), None, Path("."))

@@ -29,6 +29,7 @@ import yaml
 
 from roverlab.errors import yaml_reason
 from roverlab.viz.errors import DashboardError
+from roverlab.viz.views import check_view, default_view, view_from_rviz
 
 __all__ = [
     "CONFIG_FORMAT",
@@ -251,6 +252,8 @@ class DashboardConfig:
 
     Attributes:
         fixed_frame: rviz's ``Global Options/Fixed Frame``.
+        view: the camera (:mod:`roverlab.viz.views`): ``{"mode": "2D"}`` or rviz's
+            ``Views/Current`` (Orbit, TopDownOrtho, ThirdPersonFollower).
         displays: in panel order (drawn in this order too, later on top).
         unsupported: ``"Name (rviz/Class)"`` of each display that was skipped.
         source: the file it came from, if any.
@@ -260,6 +263,7 @@ class DashboardConfig:
     displays: list[DisplayConfig] = field(default_factory=list)
     unsupported: list[str] = field(default_factory=list)
     source: str = ""
+    view: dict[str, Any] = field(default_factory=default_view)
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON document :func:`save_config` writes."""
@@ -269,6 +273,7 @@ class DashboardConfig:
             "fixed_frame": self.fixed_frame,
             "displays": [d.to_dict() for d in self.displays],
             "unsupported": list(self.unsupported),
+            "view": dict(self.view),
         }
 
 
@@ -341,7 +346,7 @@ def _check_option(where: str, kind: str, name: str, value: Any) -> Any:
     choices = {
         "color_scheme": ("map", "costmap", "raw"),
         "color_map": ("gray", "jet", "hot", "rainbow"),
-        "color_transformer": ("FlatColor", "Intensity", "AxisColor"),
+        "color_transformer": ("FlatColor", "Intensity", "AxisColor", "RGB8"),
     }.get(name)
     if choices and value not in choices:
         raise ConfigError(f"{where}: option {name!r} must be one of {', '.join(choices)}")
@@ -393,6 +398,10 @@ def config_from_dict(data: Any, where: str = "dashboard config") -> DashboardCon
     if not isinstance(frame, str) or not frame or not isinstance(displays, list):
         raise ConfigError(f"{where}: fixed_frame must be a name and displays a list")
     unsupported = [str(u) for u in data.get("unsupported", [])]
+    try:
+        view = check_view(data.get("view"), where)
+    except DashboardError as err:
+        raise ConfigError(str(err)) from err
     return DashboardConfig(
         fixed_frame=frame.lstrip("/"),
         displays=[
@@ -400,6 +409,7 @@ def config_from_dict(data: Any, where: str = "dashboard config") -> DashboardCon
         ],
         unsupported=unsupported,
         source=where,
+        view=view,
     )
 
 
@@ -435,7 +445,7 @@ def _rviz_display(d: Mapping[str, Any], kind: str, where: str) -> DisplayConfig:
         num("Alpha", "alpha")
     if "Color" in d and "color" in DISPLAY_KINDS[kind].options:
         opts["color"] = _rviz_color(d["Color"], where)
-    topic = d.get("Topic")
+    topic = d.get("Topic", d.get("Image Topic"))  # rviz 1 Image/Camera: "Image Topic"
     if kind == "grid":
         num("Cell Size", "cell_size")
         num("Plane Cell Count", "cell_count", integer=True)
@@ -519,7 +529,7 @@ def parse_rviz(text: str, source: str = "<rviz>") -> DashboardConfig:
         raise ConfigError(f"{source}: no 'Visualization Manager' section: not an .rviz file")
     options = manager.get("Global Options") or {}
     frame = str(options.get("Fixed Frame", "map")).lstrip("/") or "map"
-    config = DashboardConfig(fixed_frame=frame, source=source)
+    config = DashboardConfig(fixed_frame=frame, source=source, view=view_from_rviz(manager))
     raw = manager.get("Displays") or []
     if not isinstance(raw, list):
         raise ConfigError(f"{source}: 'Displays' must be a list")

@@ -17,11 +17,24 @@ from pathlib import Path
 from typing import Final
 
 from roverlab.core import Context, Node
-from roverlab.viz.config import ConfigError, DashboardConfig, default_config, load_config
+from roverlab.viz.config import (
+    ConfigError,
+    DashboardConfig,
+    DisplayConfig,
+    default_config,
+    load_config,
+)
 from roverlab.viz.errors import DashboardError
 from roverlab.viz.server import DashboardServer
 
-__all__ = ["DEFAULT_PORT", "RvizArgs", "parse_rviz_args", "start_rviz"]
+__all__ = [
+    "DEFAULT_PORT",
+    "RvizArgs",
+    "image_view_config",
+    "parse_rviz_args",
+    "start_image_view",
+    "start_rviz",
+]
 
 DEFAULT_PORT: Final = 8080
 _FLAGS_WITH_VALUE: Final = ("-l", "--log-config", "-s", "--splash-screen", "--opengl")
@@ -115,3 +128,64 @@ def start_rviz(
         return None
     server.bridge.node.get_logger().info(f"rviz: the web dashboard is at {server.url}")
     return server.bridge.node
+
+
+def image_view_config(topic: str | None) -> DashboardConfig:
+    """rqt_image_view's view: the default displays with the image panel on ``topic``
+    (None: the panel's topic picker, as rqt_image_view starts with an empty choice)."""
+    config = default_config()
+    for d in config.displays:
+        if d.kind == "image":
+            d.topic = topic or ""
+            d.enabled = True
+            break
+    else:
+        config.displays.append(DisplayConfig("image", "Image", True, topic or "", {}))
+    return config
+
+
+def start_image_view(
+    context: Context,
+    args: str,
+    *,
+    remaps: dict[str, str],
+    node_name: str = "rqt_image_view",
+    source: str = "",
+    warn: Callable[[str], None],
+) -> Node | None:
+    """``<node pkg="rqt_image_view" type="rqt_image_view" args="/usb_cam/image_raw"/>``:
+    the dashboard's image panel on the topic given as the argument (or remapped from
+    ``image``), served on ``$ROVERLAB_DASHBOARD_PORT`` or, when that is taken (an rviz in
+    the same launch), on a free port; the URL is logged.
+
+    Raises:
+        DashboardError: a bad ``$ROVERLAB_DASHBOARD_PORT``.
+    """
+    where = f"{source}: " if source else ""
+    positional = [a for a in shlex.split(args) if not a.startswith("-")]
+    topic = positional[0] if positional else remaps.get("image") or remaps.get("/image")
+    host = os.environ.get("ROVERLAB_DASHBOARD_HOST", "127.0.0.1")
+    text = os.environ.get("ROVERLAB_DASHBOARD_PORT", str(DEFAULT_PORT))
+    try:
+        port = int(text)
+    except ValueError:
+        raise DashboardError(
+            f"ROVERLAB_DASHBOARD_PORT must be a port number, got {text!r}"
+        ) from None
+    for attempt in (port, 0):
+        server = DashboardServer(
+            context, host, attempt, config=image_view_config(topic), node_name=node_name
+        )
+        try:
+            server.start()
+        except DashboardError as err:
+            server.bridge.node.destroy_node()
+            if attempt == 0:
+                warn(f"{where}rqt_image_view not started: {err}")
+                return None
+            continue
+        server.bridge.node.get_logger().info(
+            f"rqt_image_view: the image panel is at {server.url}" + (f" ({topic})" if topic else "")
+        )
+        return server.bridge.node
+    return None

@@ -11,7 +11,9 @@ that follow 4-byte aligned in the browser). All numbers are little-endian:
   of that window of the last full map (only changed cells travel);
 * :data:`KIND_POINTS` (laser scans, point clouds): ``<u32 count, u32 buckets>``, then
   ``buckets`` u32 point counts, ``buckets`` RGBA u8 colours, then ``count`` float32
-  ``(x, y)`` pairs in the fixed frame sorted by bucket (one colour per bucket);
+  ``(x, y)`` pairs in the fixed frame sorted by bucket (one colour per bucket); with
+  flag :data:`POINTS_XYZ` ``(x, y, z)`` triples, with :data:`POINTS_RGB` then ``count``
+  RGBA u8 colours, one per point (rviz's RGB8);
 * :data:`KIND_POSES` (odometry, pose arrays, poses): ``<u32 count>`` then ``count`` float32
   ``(x, y, yaw)`` in the fixed frame;
 * :data:`KIND_PATH`: ``<u32 count>`` then ``count`` float32 ``(x, y)`` in the fixed frame;
@@ -34,7 +36,7 @@ import numpy as np
 from numpy.typing import NDArray
 from PIL import Image
 
-from roverlab.description.model import Box, Cylinder, RobotModel, Sphere
+from roverlab.description.model import Box, Cylinder, Mesh, RobotModel, Sphere
 from roverlab.geometry import Transform3
 
 __all__ = [
@@ -49,7 +51,10 @@ __all__ = [
     "KIND_POINTS",
     "KIND_POSES",
     "KIND_SCAN",
+    "POINTS_RGB",
+    "POINTS_XYZ",
     "VisualOutline",
+    "VisualShape",
     "colorize",
     "convex_hull",
     "encode_image",
@@ -63,6 +68,7 @@ __all__ = [
     "image_to_rgb8",
     "rainbow",
     "robot_outlines",
+    "robot_shapes",
 ]
 
 KIND_MAP: Final = 1
@@ -72,6 +78,8 @@ KIND_IMAGE: Final = 3
 KIND_POSES: Final = 4
 KIND_PATH: Final = 5
 KIND_MAP_PATCH: Final = 6
+POINTS_XYZ: Final = 1
+POINTS_RGB: Final = 2
 IMAGE_JPEG: Final = 0
 IMAGE_PNG: Final = 1
 
@@ -110,12 +118,32 @@ def encode_points(
     palette: NDArray[np.uint8] | Sequence[Sequence[int]] = ((255, 0, 0, 255),),
     *,
     slot: int = 0,
+    rgb: NDArray[np.uint8] | None = None,
 ) -> bytes:
-    """A :data:`KIND_POINTS` frame: ``(N, 2)`` points in the fixed frame, m, each drawn in
-    ``palette[buckets[i]]`` (RGBA 0..255; all in ``palette[0]`` when ``buckets`` is None)."""
-    pts = np.asarray(points_xy, dtype=np.float64).reshape(-1, 2)
+    """A :data:`KIND_POINTS` frame: ``(N, 2)`` or ``(N, 3)`` points in the fixed frame, m,
+    each drawn in ``palette[buckets[i]]`` (RGBA 0..255; all in ``palette[0]`` when
+    ``buckets`` is None). ``(N, 3)`` points set flag :data:`POINTS_XYZ`; per-point ``rgb``
+    (``(N, 3)`` uint8, rviz's RGB8 transformer) sets :data:`POINTS_RGB` and follows the
+    points as RGBA bytes (alpha from ``palette[0]``)."""
+    arr = np.asarray(points_xy, dtype=np.float64)
+    dims = 3 if arr.ndim == 2 and arr.shape[1] == 3 else 2
+    pts = arr.reshape(-1, dims)
     colours = np.asarray(palette, dtype=np.uint8).reshape(-1, 4)
     n_buckets = len(colours)
+    flags = POINTS_XYZ if dims == 3 else 0
+    if rgb is not None:
+        flags |= POINTS_RGB
+        alpha = np.full((len(pts), 1), colours[0, 3], dtype=np.uint8)
+        per_point = np.hstack((np.asarray(rgb, dtype=np.uint8).reshape(-1, 3), alpha))
+        counts = np.array([len(pts)] + [0] * (n_buckets - 1), dtype="<u4")
+        head = struct.pack("<BBHII", KIND_POINTS, flags, slot, len(pts), n_buckets)
+        return (
+            head
+            + counts.tobytes()
+            + colours.tobytes()
+            + np.ascontiguousarray(pts, dtype="<f4").tobytes()
+            + per_point.tobytes()
+        )
     if buckets is None:
         counts = np.array([len(pts)] + [0] * (n_buckets - 1), dtype="<u4")
     else:
@@ -123,7 +151,7 @@ def encode_points(
         order = np.argsort(idx, kind="stable")
         pts = pts[order]
         counts = np.bincount(idx, minlength=n_buckets).astype("<u4")
-    head = struct.pack("<BBHII", KIND_POINTS, 0, slot, len(pts), n_buckets)
+    head = struct.pack("<BBHII", KIND_POINTS, flags, slot, len(pts), n_buckets)
     return (
         head
         + counts.tobytes()
@@ -364,4 +392,64 @@ def robot_outlines(model: RobotModel) -> list[VisualOutline]:
             if visual.material is not None and visual.material.rgba is not None:
                 rgba = tuple(float(c) for c in visual.material.rgba)  # type: ignore[assignment]
             out.append(VisualOutline(link.name, visual.origin.apply(pts), rgba))
+    return out
+
+
+@dataclass(frozen=True)
+class VisualShape:
+    """One URDF visual for the 3D view: geometry, pose in its link and colour.
+
+    Attributes:
+        link: the link the visual belongs to.
+        geometry: ``{"type": "box", "size": [x, y, z]}``, ``{"type": "cylinder",
+            "radius", "length"}`` (along z), ``{"type": "sphere", "radius"}`` or
+            ``{"type": "mesh", "filename", "scale"}``.
+        origin: ``[x, y, z, qx, qy, qz, qw]`` of the visual in the link's frame.
+        rgba: the URDF material's colour 0..1, grey when it gives none.
+    """
+
+    link: str
+    geometry: dict[str, Any]
+    origin: list[float]
+    rgba: tuple[float, float, float, float]
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "link": self.link,
+            "geometry": self.geometry,
+            "origin": self.origin,
+            "rgba": list(self.rgba),
+        }
+
+
+def _geometry_dict(geometry: object) -> dict[str, Any] | None:
+    if isinstance(geometry, Box):
+        return {"type": "box", "size": [float(s) for s in geometry.size]}
+    if isinstance(geometry, Cylinder):
+        return {"type": "cylinder", "radius": geometry.radius, "length": geometry.length}
+    if isinstance(geometry, Sphere):
+        return {"type": "sphere", "radius": geometry.radius}
+    if isinstance(geometry, Mesh):
+        return {
+            "type": "mesh",
+            "filename": geometry.filename,
+            "scale": [float(s) for s in geometry.scale],
+        }
+    return None
+
+
+def robot_shapes(model: RobotModel) -> list[VisualShape]:
+    """Every visual of ``model`` as a :class:`VisualShape` (rviz's RobotModel display)."""
+    out: list[VisualShape] = []
+    for link in model.links.values():
+        for visual in link.visuals:
+            geometry = _geometry_dict(visual.geometry)
+            if geometry is None:
+                continue
+            rgba = (0.6, 0.6, 0.6, 1.0)
+            if visual.material is not None and visual.material.rgba is not None:
+                rgba = tuple(float(c) for c in visual.material.rgba)  # type: ignore[assignment]
+            o = visual.origin
+            origin = [round(float(v), 6) for v in (*o.translation, *o.rotation)]
+            out.append(VisualShape(link.name, geometry, origin, rgba))
     return out

@@ -9,7 +9,8 @@ robot outline, status tree; the topic list with rates once a second) at
 :attr:`DashboardServer.state_rate_hz`.
 
 The page sends JSON back: tools ``{"type": "goal" | "initialpose", "x", "y", "yaw"}``,
-``{"type": "point", "x", "y"}``; drive ``{"type": "key", "key": "i"}``,
+``{"type": "point", "x", "y"}``; joint sliders ``{"type": "joint", "name", "position"}``;
+drive ``{"type": "key", "key": "i"}``,
 ``{"type": "speed", "speed", "turn"}``; ``{"type": "config", "config": {...}}`` (the
 whole configuration, :meth:`DashboardConfig.to_dict` form), ``{"type": "save_config"}``,
 ``{"type": "save_map", "name": "map"}`` and ``{"type": "image_topic", "topic"}``. Replies
@@ -45,6 +46,7 @@ from fastapi.responses import FileResponse, PlainTextResponse, Response
 from fastapi.staticfiles import StaticFiles
 
 from roverlab.core import Context
+from roverlab.description.packages import resolve_uri
 from roverlab.errors import RoverlabError
 from roverlab.viz.bridge import DisplayState, VizBridge
 from roverlab.viz.config import DashboardConfig, config_from_dict, save_config
@@ -169,6 +171,23 @@ class DashboardServer:
                 headers={"Content-Disposition": f'attachment; filename="{DEFAULT_CONFIG_NAME}"'},
             )
 
+        @app.get("/mesh/{index}")
+        def mesh(index: int, request: Request) -> Response:
+            """The mesh file of the robot model's ``index``-th visual (only those files)."""
+            if not self._authorised(request.query_params.get("token")):
+                return PlainTextResponse("forbidden: wrong or missing token", status_code=403)
+            shapes = self.bridge.shapes
+            if not 0 <= index < len(shapes) or shapes[index]["geometry"]["type"] != "mesh":
+                return PlainTextResponse(f"no mesh visual {index}", status_code=404)
+            uri = str(shapes[index]["geometry"]["filename"])
+            try:
+                path = resolve_uri(uri)
+            except RoverlabError as err:
+                return PlainTextResponse(f"{uri}: {err}", status_code=404)
+            if not path.is_file():
+                return PlainTextResponse(f"{uri}: no such file {path}", status_code=404)
+            return FileResponse(path)
+
         app.mount("/static", StaticFiles(directory=STATIC_DIR), name="static")
 
         @app.websocket("/ws")
@@ -221,6 +240,8 @@ class DashboardServer:
             bridge.drive_key(str(msg["key"])[:1])
         elif kind == "speed":
             bridge.set_speeds(_number(msg, "speed"), _number(msg, "turn"))
+        elif kind == "joint":
+            bridge.set_joint(str(msg["name"]), _number(msg, "position"))
         elif kind == "image_topic":
             bridge.select_image(str(msg["topic"]))
         elif kind == "config":

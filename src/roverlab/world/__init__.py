@@ -22,6 +22,7 @@ from roverlab.world.model import (
     SphereShape,
     World,
 )
+from roverlab.world.report import group_warnings, world_warnings
 from roverlab.world.sdf import load_sdf, model_search_path
 from roverlab.world.yaml_world import load_yaml_world
 
@@ -37,10 +38,12 @@ __all__ = [
     "World",
     "WorldError",
     "bundled_world_path",
+    "group_warnings",
     "load_image_world",
     "load_sdf",
     "load_world",
     "load_yaml_world",
     "model_search_path",
     "occupied_rectangles",
+    "world_warnings",
 ]

@@ -20,6 +20,7 @@ BUNDLED_WORLDS_DIR = Path(__file__).resolve().parent.parent / "worlds"
 BUNDLED_WORLDS: dict[str, str] = {
     "empty": "ground plane only",
     "maze": "8 m x 8 m Building Editor maze, 1.45 m corridors, spawn in the centre cell",
+    "maze_faces": "the maze with three face posters (face_detector), one 2.3 m north of the spawn",
     "office": "12 m x 8 m office: reception, three rooms, desks, pillars, a face poster",
     "house": "10 m x 8 m house: living room, kitchen, bedroom, bathroom, furniture",
     "warehouse": "14 m x 9 m warehouse: pallet racks and aisles, loading area, site office",

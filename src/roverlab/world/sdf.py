@@ -8,7 +8,10 @@ What is read:
   (SDF 1.5/1.6) and ``relative_to`` (1.7) may name the world, the parent model or a
   link of the same model;
 * ``<collision>`` geometry: ``box``, ``cylinder``, ``sphere``, ``polyline`` (a closed,
-  extruded outline); ``plane`` is the ground (its visual's colour becomes the floor);
+  extruded outline), ``mesh`` (STL, Collada, OBJ from ``model://``, ``file://`` or a
+  relative path, with ``<scale>``: each part's convex outline extruded over its z range,
+  see :mod:`roverlab.geometry.mesh`; the mesh's colour when no visual material gives
+  one); ``plane`` is the ground (its visual's colour becomes the floor);
 * colours from the matching ``<visual>``'s ``<material>``: ``<diffuse>``, then a script
   material (Gazebo's own, e.g. ``Gazebo/Grey``, or one defined in a model's OGRE
   ``.material`` script, whose ``texture`` image is used as a texture), then
@@ -20,8 +23,10 @@ What is read:
 * ``<gravity>`` (world or physics) and ``<scene><background>`` (the sky colour).
 
 Building Editor models are plain models: each wall is a link ``Wall_N`` with a box
-collision. Robots (models with sensors or plugins), actors, meshes, heightmaps and other
-unknown elements are skipped and reported in :attr:`World.warnings`; lights, physics,
+collision. Robots (models with sensors or plugins), actors, heightmaps, models not found
+and other unknown elements are skipped and reported in :attr:`World.warnings` (a missing
+``model://NAME`` as ``model NAME skipped: model://X not found``, which
+:func:`roverlab.world.group_warnings` groups); lights, physics,
 GUI and the like are ignored silently. Robots spawn at the origin, as in Gazebo.
 
 Includes are looked up (first match wins) in: the caller's ``model_path``,
@@ -41,6 +46,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from roverlab.geometry import SE2, Transform3, quat_from_rpy, quat_normalize
+from roverlab.geometry.mesh import MeshError, load_mesh, mesh_outlines
 from roverlab.world._materials import GAZEBO_MATERIALS, ScriptMaterial, read_material_script
 from roverlab.world._xml import XmlDoc, parse_xml_file
 from roverlab.world.errors import WorldError
@@ -85,6 +91,31 @@ _QUIET_WORLD_TAGS = frozenset(
 )
 
 
+def _package_model_paths(world_dir: Path) -> list[Path]:
+    """``<export><gazebo_ros gazebo_model_path="${prefix}/models"/>`` of the ROS package
+    holding the world (the nearest ``package.xml`` up to 3 folders up), which gazebo_ros
+    adds to GAZEBO_MODEL_PATH."""
+    for folder in [world_dir, *list(world_dir.parents)[:3]]:
+        manifest = folder / "package.xml"
+        if not manifest.is_file():
+            continue
+        try:
+            root = ET.parse(manifest).getroot()
+        except (ET.ParseError, OSError):
+            return []
+        out: list[Path] = []
+        for exp in root.iter("gazebo_ros"):
+            for attr in ("gazebo_model_path", "gazebo_media_path"):
+                raw = exp.get(attr)
+                if raw and attr == "gazebo_model_path":
+                    for part in raw.split(os.pathsep):
+                        path = part.replace("${prefix}", str(folder)).strip()
+                        if path:
+                            out.append(Path(path))
+        return out
+    return []
+
+
 def model_search_path(
     model_path: Sequence[str | os.PathLike[str]] = (), world_dir: Path | None = None
 ) -> list[Path]:
@@ -93,7 +124,7 @@ def model_search_path(
     for var in ("ROVERLAB_MODEL_PATH", "GAZEBO_MODEL_PATH"):
         paths += [Path(p) for p in os.environ.get(var, "").split(os.pathsep) if p]
     if world_dir is not None:
-        paths += [world_dir, world_dir / "models"]
+        paths += [world_dir, world_dir / "models", *_package_model_paths(world_dir)]
     home = Path.home()
     paths += [home / ".gazebo" / "models", home / "building_editor_models", BUNDLED_MODELS_DIR]
     unique: list[Path] = []
@@ -138,6 +169,8 @@ class _Geom:
     kind: str
     shape: Callable[[Transform3, RGB, Path | None, str], Shape] | None
     signature: tuple[object, ...]
+    # a mesh: (world pose, visual colour or None, name) -> its parts' shapes
+    parts: Callable[[Transform3, RGB | None, str], list[Shape]] | None = None
 
 
 def _join(label: str, part: str) -> str:
@@ -270,10 +303,9 @@ class _SdfLoader:
         model_dir = self._resolve_uri(uri, doc)
         if model_dir is None or not model_dir.is_dir():
             if uri.startswith("model://"):
-                searched = ", ".join(str(p) for p in self.search)
-                raise WorldError(
-                    f"{doc.where(uri_el)}: {ilabel}: {uri} not found; searched: {searched}"
-                )
+                name = _text(el.find("name")) or uri[len("model://") :].split("/")[0]
+                self._warn(doc, uri_el, f"model {name} skipped: {uri} not found")
+                return
             if "://" in uri and not uri.startswith("file://"):
                 raise WorldError(
                     f"{doc.where(uri_el)}: {ilabel}: {uri}: online models are not fetched; "
@@ -479,6 +511,9 @@ class _SdfLoader:
                     if self.floor_rgb is None and rgb is not None:
                         self.floor_rgb = rgb
                     continue
+                if geom.parts is not None:
+                    self.shapes.extend(geom.parts(ctf, rgb, col.get("name", "")))
+                    continue
                 assert geom.shape is not None
                 self.shapes.append(
                     geom.shape(ctf, rgb or DEFAULT_RGB, texture, col.get("name", ""))
@@ -650,9 +685,54 @@ class _SdfLoader:
             return out
         if kind == "plane":
             return [_Geom(kind, None, (kind,))]
+        if kind == "mesh":
+            return self._mesh(doc, shape_el, glabel, quiet=quiet)
         if not quiet:
             self._warn(doc, shape_el, f"{label}: <{kind}> geometry is not supported: skipped")
         return []
+
+    def _mesh(self, doc: XmlDoc, el: ET.Element, label: str, *, quiet: bool) -> list[_Geom]:
+        uri = _text(el.find("uri"))
+        if not uri:
+            raise WorldError(f"{doc.where(el)}: {label}: <mesh> needs a <uri>")
+        scale_el = el.find("scale")
+        scale = (1.0, 1.0, 1.0)
+        if scale_el is not None:
+            sx, sy, sz = self._floats(doc, scale_el, 3, _join(label, "<scale>"))
+            scale = (sx, sy, sz)
+        signature = ("mesh", uri, *scale)
+        if quiet:  # a visual: only its signature matters (which collision it colours)
+            return [_Geom("mesh", None, signature)]
+        if el.find("submesh") is not None:
+            self._warn(doc, el, f"{label}: <submesh> ignored: the whole mesh {uri} is used")
+        path = self._resolve_uri(uri, doc)
+        if path is None or not path.is_file():
+            self._warn(doc, el, f"{label}: mesh {uri} not found: skipped")
+            return []
+        try:
+            parts = load_mesh(path)
+        except MeshError as err:
+            self._warn(doc, el, f"{label}: {err}: skipped")
+            return []
+
+        def shapes(tf: Transform3, rgb: RGB | None, name: str) -> list[Shape]:
+            out: list[Shape] = []
+            for o in mesh_outlines(parts, tf, scale):
+                height = o.z_max - o.z_min
+                if height < 1e-3:
+                    continue  # a flat sheet: nothing stands up from the floor
+                out.append(
+                    PolylineShape(
+                        pose=Transform3((0.0, 0.0, o.z_min)),
+                        points=tuple((float(x), float(y)) for x, y in o.points),
+                        height=height,
+                        rgb=rgb or o.rgb or DEFAULT_RGB,
+                        name=name,
+                    )
+                )
+            return out
+
+        return [_Geom("mesh", None, signature, shapes)]
 
     def _polyline(self, doc: XmlDoc, pl: ET.Element, label: str) -> _Geom:
         (height,) = self._positive(doc, pl, "height", 1, (1.0,), label)

@@ -104,6 +104,12 @@ class ZenohOptions:
         user, password: user/password authentication (both sides must use the same).
         tls_root_ca, tls_cert, tls_key: files for ``tls/`` endpoints (server cert and
             key where this side listens; the CA that signed the other side's cert).
+        present_credentials: offer ``user``/``password`` to the endpoints this side
+            connects to (False: only check them on sessions that come in, so a robot
+            that listens with a password can still join its machine's daemon).
+        connect_timeout_s: fail opening the session when no ``connect`` endpoint accepts
+            it within this time (a wrong password, nobody listening) instead of retrying
+            in the background; None retries forever.
     """
 
     mode: str = "peer"
@@ -115,6 +121,8 @@ class ZenohOptions:
     tls_root_ca: str | None = None
     tls_cert: str | None = None
     tls_key: str | None = None
+    present_credentials: bool = True
+    connect_timeout_s: float | None = None
     domain: int = field(default_factory=domain_id)
 
     def to_config(self) -> tuple[zenoh.Config, list[str]]:
@@ -141,9 +149,14 @@ class ZenohOptions:
             with os.fdopen(fd, "w") as fh:
                 fh.write(f"{self.user}:{self.password}\n")
             temps.append(path)
-            put("transport/auth/usrpwd/user", self.user)
-            put("transport/auth/usrpwd/password", self.password)
+            if self.present_credentials:
+                put("transport/auth/usrpwd/user", self.user)
+                put("transport/auth/usrpwd/password", self.password)
             put("transport/auth/usrpwd/dictionary_file", path)
+        if self.connect_timeout_s is not None and self.connect:
+            ms = int(self.connect_timeout_s * 1000)
+            put("connect/timeout_ms", {"router": -1, "peer": ms, "client": ms})
+            put("connect/exit_on_failure", {"router": False, "peer": True, "client": True})
         if self.tls_root_ca is not None:
             put("transport/link/tls/root_ca_certificate", self.tls_root_ca)
         if self.tls_cert is not None:
@@ -154,13 +167,44 @@ class ZenohOptions:
 
 
 def open_session(options: ZenohOptions) -> tuple[zenoh.Session, list[str]]:
-    cfg, temps = options.to_config()
-    try:
-        return zenoh.open(cfg), temps
-    except Exception as err:
-        for path in temps:
-            os.unlink(path)
-        raise TransportError(f"cannot open Zenoh session: {err}") from err
+    """Open a Zenoh session; an explicit ``connect`` that no endpoint accepts (within
+    ``connect_timeout_s``) is one clear error saying whether nothing answers there or the
+    other side refused the session. An endpoint that starts listening while this side
+    waits (a robot still booting) gets a second attempt before it counts as refusing."""
+    answered_before = options.connect_timeout_s is not None and any(
+        endpoint_reachable(ep, timeout_s=1.0) for ep in options.connect
+    )
+    for attempt in (1, 2):
+        cfg, temps = options.to_config()
+        try:
+            return zenoh.open(cfg), temps
+        except Exception as err:
+            for path in temps:
+                os.unlink(path)
+            if not (options.connect and "Unable to connect" in str(err)):
+                raise TransportError(f"cannot open Zenoh session: {err}") from err
+            answers = any(endpoint_reachable(ep, timeout_s=1.0) for ep in options.connect)
+            if answers and not answered_before and attempt == 1:
+                answered_before = True  # it came up meanwhile: try once more
+                continue
+            raise TransportError(_connect_failure(options, answers)) from err
+    raise AssertionError("unreachable")  # pragma: no cover
+
+
+def _connect_failure(options: ZenohOptions, answers: bool) -> str:
+    """Why no ``connect`` endpoint took the session: nothing listening, or refused."""
+    endpoints = ", ".join(options.connect)
+    if answers:
+        auth = (
+            "wrong --user/--password"
+            if options.user is not None
+            else "it requires --user and --password"
+        )
+        return f"{endpoints} refused the session: {auth} (or another TLS setup)"
+    return (
+        f"cannot connect to {endpoints}: nothing answers there (is roverlab running on that "
+        "machine with --listen on that address and port?)"
+    )
 
 
 def endpoint_reachable(endpoint: str, timeout_s: float = 0.2) -> bool:

@@ -11,7 +11,7 @@
   const CHOICES = {
     color_scheme: ["map", "costmap", "raw"],
     color_map: ["gray", "jet", "hot", "rainbow"],
-    color_transformer: ["FlatColor", "Intensity", "AxisColor"],
+    color_transformer: ["FlatColor", "Intensity", "AxisColor", "RGB8"],
   };
   const KIND_TYPES = {
     map: ["nav_msgs/msg/OccupancyGrid"], laser_scan: ["sensor_msgs/msg/LaserScan"],
@@ -32,7 +32,7 @@
 
   // view: world point (cx, cy) at the canvas centre, `scale` pixels per metre, the screen's
   // x axis pointing along world direction `angle`
-  const view = { cx: 0, cy: 0, scale: 50, angle: 0, placed: false, follow: "", rotate: false };
+  const view = { cx: 0, cy: 0, scale: 50, angle: 0, placed: false, follow: "", rotate: false, mode: "2D" };
   const data = { config: null, configText: "", layers: [], state: null, topics: [], frames: 0,
                  defaults: null };
   Object.defineProperty(data, "map", { get: () => firstLayer("map", "map") });
@@ -153,6 +153,7 @@
       off.width = w; off.height = h;
       L.map = { w, h, res, ox, oy, oyaw, cells, canvas: off, ctx: off.getContext("2d") };
       paintMap(L.map, cfg ? cfg.options.color_scheme : "map", 0, 0, w, h);
+      L.map.version = 1; L.map.dirty = null;
       if (!view.placed && !(data.state && (data.state.frames.base_footprint || data.state.frames.base_link))) {
         view.cx = ox + w * res / 2; view.cy = oy + h * res / 2;
       }
@@ -164,29 +165,47 @@
       const patch = new Int8Array(buf, 20, w * h);
       for (let r = 0; r < h; r++) m.cells.set(patch.subarray(r * w, (r + 1) * w), (y0 + r) * m.w + x0);
       paintMap(m, m.scheme, x0, y0, w, h);
+      m.version = (m.version || 0) + 1;
+      m.dirty = m.dirty ? [Math.min(m.dirty[0], x0), Math.min(m.dirty[1], y0), Math.max(m.dirty[2], x0 + w), Math.max(m.dirty[3], y0 + h)] : [x0, y0, x0 + w, y0 + h];
     } else if (kind === KIND_POINTS) {
+      // flags: 1 = (x, y, z) triples, 2 = one RGBA colour per point after the points
       const n = dv.getUint32(4, true), nb = dv.getUint32(8, true);
+      const stride = flags & 1 ? 3 : 2;
       const counts = new Uint32Array(buf, 12, nb);
       const colours = new Uint8Array(buf, 12 + 4 * nb, 4 * nb);
-      const pts = new Float32Array(buf, 12 + 8 * nb, n * 2);
+      const pts = new Float32Array(buf, 12 + 8 * nb, n * stride);
+      let rgba;
+      if (flags & 2) rgba = new Uint8Array(buf, 12 + 8 * nb + 4 * n * stride, 4 * n);
+      else {
+        rgba = new Uint8Array(4 * n);
+        let k = 0;
+        for (let b = 0; b < nb; b++) {
+          for (let j = 0; j < counts[b]; j++, k++) rgba.set(colours.subarray(4 * b, 4 * b + 4), 4 * k);
+        }
+      }
       const buckets = [];
       let at = 0;
-      for (let b = 0; b < nb; b++) {
-        if (counts[b]) buckets.push({ color: `rgba(${colours[4 * b]},${colours[4 * b + 1]},${colours[4 * b + 2]},${colours[4 * b + 3] / 255})`,
-                                      pts: pts.subarray(at * 2, (at + counts[b]) * 2) });
-        at += counts[b];
+      if (!(flags & 2)) {
+        for (let b = 0; b < nb; b++) {
+          if (counts[b]) buckets.push({ color: `rgba(${colours[4 * b]},${colours[4 * b + 1]},${colours[4 * b + 2]},${colours[4 * b + 3] / 255})`,
+                                        pts: pts.subarray(at * stride, (at + counts[b]) * stride) });
+          at += counts[b];
+        }
       }
-      const scan = { t: performance.now(), n, buckets, length: n * 2 };
+      const scan = { t: performance.now(), n, buckets, length: n * 2, stride, xyz: pts, rgba, perPoint: !!(flags & 2) };
       const decay = cfg ? (cfg.options.decay_s || 0) : 0;
       const keep = (L.points || []).filter((p) => decay > 0 && scan.t - p.t < decay * 1000);
       keep.push(scan);
       L.points = keep;
+      L.version = (L.version || 0) + 1;
     } else if (kind === KIND_POSES) {
       const n = dv.getUint32(4, true);
       L.poses = new Float32Array(buf, 8, n * 3);
+      L.version = (L.version || 0) + 1;
     } else if (kind === KIND_PATH) {
       const n = dv.getUint32(4, true);
       L.path = new Float32Array(buf, 8, n * 2);
+      L.version = (L.version || 0) + 1;
     } else if (kind === KIND_IMAGE) {
       const mime = flags === 1 ? "image/png" : "image/jpeg";
       const el = document.querySelector(`img[data-slot="${slot}"]`);
@@ -214,9 +233,33 @@
     updateStatus(msg.status);
     updateFrameSelects(msg);
     renderImageTopics(msg.image_topics || []);
+    renderJoints(msg.joints || []);
     const sp = $("speed"), tu = $("turn");
     if (document.activeElement !== sp) sp.value = msg.drive.speed.toFixed(3);
     if (document.activeElement !== tu) tu.value = msg.drive.turn.toFixed(3);
+  }
+
+  // joint_state_publisher_gui: one slider per movable joint of the robot description
+  function renderJoints(joints) {
+    const box = $("joints");
+    $("joints-panel").style.display = joints.length ? "" : "none";
+    const names = joints.map((j) => j.name).join(",");
+    if (box.dataset.names !== names) {
+      box.dataset.names = names; box.innerHTML = "";
+      for (const j of joints) {
+        const row = document.createElement("div"); row.className = "row";
+        const label = document.createElement("span"); label.textContent = j.name; label.style.width = "40%";
+        const inp = document.createElement("input"); inp.type = "range"; inp.className = "joint";
+        inp.min = j.lower; inp.max = j.upper; inp.step = (j.upper - j.lower) / 1000; inp.dataset.joint = j.name;
+        const val = document.createElement("span"); val.className = "joint-value";
+        inp.oninput = () => { val.textContent = Number(inp.value).toFixed(2); send({ type: "joint", name: j.name, position: Number(inp.value) }); };
+        row.append(label, inp, val); box.append(row);
+      }
+    }
+    for (const j of joints) {
+      const inp = box.querySelector(`input[data-joint="${CSS.escape(j.name)}"]`);
+      if (inp && document.activeElement !== inp) { inp.value = j.position; inp.nextSibling.textContent = j.position.toFixed(2); }
+    }
   }
 
   // -------------------------------------------------------------- side panel
@@ -238,6 +281,7 @@
       if (o && o.kind === d.kind && o.topic === d.topic && data.layers[i]) layers[i] = data.layers[i];
     });
     data.layers = layers;
+    for (const hook of configHooks) hook(config, old);
     renderDisplays();
     renderImages();
   }
@@ -505,10 +549,18 @@
     if (decay > 0) L.points = L.points.filter((p, i) => i === L.points.length - 1 || now - p.t < decay);
     const h = px(d.options.size_px || 3) / 2, s = 2 * h;
     for (const scan of L.points) {
+      const st = scan.stride;
+      if (scan.perPoint) {
+        const p = scan.xyz, c = scan.rgba;
+        for (let i = 0, k = 0; i < p.length; i += st, k += 4) {
+          g.fillStyle = `rgba(${c[k]},${c[k + 1]},${c[k + 2]},${c[k + 3] / 255})`;
+          g.fillRect(p[i] - h, p[i + 1] - h, s, s);
+        }
+      }
       for (const b of scan.buckets) {
         g.fillStyle = b.color;
         const p = b.pts;
-        for (let i = 0; i < p.length; i += 2) g.fillRect(p[i] - h, p[i + 1] - h, s, s);
+        for (let i = 0; i < p.length; i += st) g.fillRect(p[i] - h, p[i + 1] - h, s, s);
       }
     }
   }
@@ -634,6 +686,7 @@
     if (view.rotate) view.angle = p[2] - Math.PI / 2;
   }
   function draw() {
+    if (view.mode && view.mode !== "2D") { requestAnimationFrame(draw); return; }  // the 3D view draws
     const w = canvas.clientWidth, h = canvas.clientHeight;
     if (canvas.width !== w || canvas.height !== h) { canvas.width = w; canvas.height = h; }
     g.setTransform(1, 0, 0, 1, 0, 0);
@@ -662,6 +715,7 @@
   }
   canvas.addEventListener("contextmenu", (ev) => ev.preventDefault());
   canvas.addEventListener("mousedown", (ev) => {
+    if (view.mode && view.mode !== "2D") return;
     const [x, y] = canvasXY(ev);
     const [wx, wy] = screenToWorld(x, y);
     const mode = ev.button === 2 || (ev.button === 0 && ev.shiftKey && tool === "move") ? "rotate" : tool;
@@ -669,7 +723,7 @@
     canvas.focus();
   });
   window.addEventListener("mousemove", (ev) => {
-    if (!drag) return;
+    if (!drag || (view.mode && view.mode !== "2D")) return;
     const [x, y] = canvasXY(ev);
     if (drag.tool === "move") {
       const c = Math.cos(view.angle), s = Math.sin(view.angle);
@@ -685,7 +739,7 @@
     }
   });
   window.addEventListener("mouseup", () => {
-    if (!drag) return;
+    if (!drag || (view.mode && view.mode !== "2D")) return;
     const d = drag; drag = null;
     if (d.tool === "goal" || d.tool === "initialpose") send({ type: d.tool, x: d.wx, y: d.wy, yaw: d.yaw });
     else if (d.tool === "point") send({ type: "point", x: d.wx, y: d.wy });
@@ -693,6 +747,7 @@
   });
   canvas.addEventListener("wheel", (ev) => {
     ev.preventDefault();
+    if (view.mode && view.mode !== "2D") return;
     const [x, y] = canvasXY(ev);
     const [wx, wy] = screenToWorld(x, y);
     view.scale = Math.min(2000, Math.max(0.5, view.scale * Math.exp(-ev.deltaY * 0.001)));
@@ -734,7 +789,9 @@
   }
   $("speed").onchange = sendSpeeds; $("turn").onchange = sendSpeeds;
 
-  window.viz = { view, data, conn, worldToScreen, screenToWorld, setTool, send };
+  const configHooks = [];
+  window.viz = { view, data, conn, worldToScreen, screenToWorld, setTool, send, PALETTES, configHooks,
+                 getTool: () => tool, framePose };
   connect();
   requestAnimationFrame(draw);
 })();

@@ -1,0 +1,567 @@
+// roverlab dashboard: the 3D view (three.js, vendored). rviz's Orbit, TopDownOrtho and
+// ThirdPersonFollower camera controllers over the data app.js keeps in window.viz.data.
+// z is up, as in ROS; every pose comes in the fixed frame.
+import * as THREE from "three";
+import { STLLoader } from "./vendor/three/addons/loaders/STLLoader.js";
+import { ColladaLoader } from "./vendor/three/addons/loaders/ColladaLoader.js";
+
+const viz = window.viz;
+const data = viz.data;
+const host = document.getElementById("main");
+const canvas2d = document.getElementById("view");
+const canvas = document.createElement("canvas");
+canvas.id = "view3d"; canvas.tabIndex = 0;
+canvas.style.cssText = "width:100%;height:100%;display:none;outline:none;background:#303030";
+host.appendChild(canvas);
+const labels = document.createElement("div");
+labels.id = "tf-labels";
+labels.style.cssText = "position:absolute;inset:0;pointer-events:none;overflow:hidden;display:none";
+host.appendChild(labels);
+
+THREE.ColorManagement.enabled = false;  // colours pass through as given (rviz's 0..1 RGB)
+const renderer = new THREE.WebGLRenderer({ canvas, antialias: false, powerPreference: "high-performance" });
+renderer.setPixelRatio(window.devicePixelRatio || 1);
+renderer.setClearColor(0x303030);
+renderer.outputColorSpace = THREE.LinearSRGBColorSpace;  // colours pass through as given, as rviz's
+const scene = new THREE.Scene();
+scene.add(new THREE.HemisphereLight(0xffffff, 0x444444, 2.2));
+const sun = new THREE.DirectionalLight(0xffffff, 1.5);
+sun.position.set(3, -2, 8); scene.add(sun);
+THREE.Object3D.DEFAULT_UP.set(0, 0, 1);
+
+const persp = new THREE.PerspectiveCamera(60, 1, 0.01, 2000);
+persp.up.set(0, 0, 1);
+const ortho = new THREE.OrthographicCamera(-1, 1, 1, -1, -1000, 1000);
+ortho.up.set(0, 1, 0);
+
+// rviz's view controllers: Orbit (focal point, distance, yaw, pitch), TopDownOrtho
+// (centre x, y, scale px/m, angle), ThirdPersonFollower (an orbit about a frame, turning with it)
+const cam = { mode: "2D", focal: new THREE.Vector3(0, 0, 0), distance: 10, yaw: 0.785, pitch: 0.785,
+              x: 0, y: 0, scale: 50, angle: 0, target: "", frames: 0, fps: 0, resolution: 1,
+              adaptive: true };
+viz.cam = cam;
+
+function setMode(mode) {
+  cam.mode = mode;
+  viz.view.mode = mode;
+  const is3d = mode !== "2D";
+  canvas.style.display = is3d ? "block" : "none";
+  labels.style.display = is3d ? "block" : "none";
+  canvas2d.style.display = is3d ? "none" : "block";
+  const sel = document.getElementById("view-mode");
+  if (sel && sel.value !== mode) sel.value = mode;
+}
+viz.setViewMode = setMode;
+
+function applyConfigView(view) {
+  if (!view || !view.mode) return;
+  if (view.focal_point) cam.focal.set(...view.focal_point);
+  if (view.distance !== undefined) cam.distance = Math.max(0.05, view.distance);
+  if (view.yaw !== undefined) cam.yaw = view.yaw;
+  if (view.pitch !== undefined) cam.pitch = view.pitch;
+  if (view.x !== undefined) { cam.x = view.x; cam.y = view.y; cam.scale = view.scale || 50; cam.angle = view.angle || 0; }
+  cam.target = view.target_frame || "";
+  setMode(view.mode);
+}
+let configViewSeen = false;
+viz.configHooks.push((config) => {
+  if (!configViewSeen && config.view) { configViewSeen = true; applyConfigView(config.view); }
+});
+if (data.config && data.config.view) { configViewSeen = true; applyConfigView(data.config.view); }
+
+function frame3(name) {
+  const s = data.state;
+  if (!s || !s.frames3) return null;
+  if (!name || name === s.fixed_frame) return [0, 0, 0, 0, 0, 0, 1];
+  return s.frames3[name] || null;
+}
+function followFrame() {
+  const s = data.state;
+  if (cam.target && frame3(cam.target)) return cam.target;
+  if (s && s.frames3) for (const f of ["base_footprint", "base_link"]) if (s.frames3[f]) return f;
+  return null;
+}
+function yawOf(q) { return Math.atan2(2 * (q[6] * q[5] + q[3] * q[4]), 1 - 2 * (q[4] * q[4] + q[5] * q[5])); }
+
+function placeCamera(w, h) {
+  if (cam.mode === "TopDownOrtho") {
+    const hw = w / 2 / cam.scale, hh = h / 2 / cam.scale;
+    Object.assign(ortho, { left: -hw, right: hw, top: hh, bottom: -hh });
+    ortho.position.set(cam.x, cam.y, 100);
+    ortho.up.set(-Math.sin(cam.angle), Math.cos(cam.angle), 0);
+    ortho.lookAt(cam.x, cam.y, 0);
+    ortho.updateProjectionMatrix();
+    return ortho;
+  }
+  let yaw = cam.yaw;
+  const focal = cam.focal.clone();
+  if (cam.mode === "ThirdPersonFollower") {
+    const f = followFrame(), p = f ? frame3(f) : null;
+    if (p) { focal.set(p[0], p[1], p[2]); yaw += yawOf([0, 0, 0, p[3], p[4], p[5], p[6]]); }
+  }
+  const cp = Math.cos(cam.pitch), sp = Math.sin(cam.pitch);
+  persp.position.set(focal.x + cam.distance * Math.cos(yaw) * cp, focal.y + cam.distance * Math.sin(yaw) * cp,
+                     focal.z + cam.distance * sp);
+  persp.lookAt(focal);
+  persp.aspect = w / h; persp.updateProjectionMatrix();
+  return persp;
+}
+
+// ----------------------------------------------------------------- displays
+const objects = new Map();  // slot -> { key, obj, ... }
+function slotObject(slot, key, make) {
+  let o = objects.get(slot);
+  if (o && o.key !== key) { scene.remove(o.obj); dispose(o.obj); o = null; }
+  if (!o) { o = { key, obj: make() }; objects.set(slot, o); scene.add(o.obj); }
+  o.seen = true;
+  return o;
+}
+function dispose(obj) {
+  obj.traverse((c) => {
+    if (c.geometry) c.geometry.dispose();
+    if (c.material) {
+      if (c.material.map) c.material.map.dispose();
+      if (c.material.uniforms) for (const u of Object.values(c.material.uniforms)) if (u.value && u.value.isTexture) u.value.dispose();
+      c.material.dispose();
+    }
+  });
+}
+function setPose(obj, p) {
+  obj.position.set(p[0], p[1], p[2]);
+  obj.quaternion.set(p[3], p[4], p[5], p[6]);
+}
+const col = (c, a) => new THREE.Color(c[0] / 255, c[1] / 255, c[2] / 255);
+
+function updateGrid(slot, d) {
+  const o = d.options, key = `grid ${o.cell_size} ${o.cell_count} ${o.color} ${o.alpha}`;
+  const e = slotObject(slot, key, () => {
+    const n = Math.max(1, o.cell_count), half = n * o.cell_size / 2, pts = [];
+    for (let i = 0; i <= n; i++) {
+      const v = -half + i * o.cell_size;
+      pts.push(v, -half, 0, v, half, 0, -half, v, 0, half, v, 0);
+    }
+    const geo = new THREE.BufferGeometry();
+    geo.setAttribute("position", new THREE.Float32BufferAttribute(pts, 3));
+    return new THREE.LineSegments(geo, new THREE.LineBasicMaterial({ color: col(o.color), transparent: true, opacity: o.alpha }));
+  });
+  const p = frame3(o.reference_frame);
+  e.obj.visible = !!p;
+  if (p) setPose(e.obj, p);
+}
+
+// The map as rviz draws it: the int8 cells as a one-byte texture and the colour scheme as a
+// 256-entry palette texture, looked up per pixel (a quarter of an RGBA texture's memory
+// traffic, and a scheme change or a patch re-uploads only bytes)
+const MAP_VERTEX = `varying vec2 vUv;
+void main() { vUv = uv; gl_Position = projectionMatrix * modelViewMatrix * vec4(position, 1.0); }`;
+const MAP_FRAGMENT = `uniform sampler2D cells; uniform sampler2D palette; uniform float alpha; varying vec2 vUv;
+void main() {
+  float v = texture2D(cells, vUv).r;
+  vec4 c = texture2D(palette, vec2((v * 255.0 + 0.5) / 256.0, 0.5));
+  if (c.a * alpha <= 0.0) discard;
+  gl_FragColor = vec4(c.rgb, c.a * alpha);
+}`;
+function paletteTexture(scheme) {
+  const pal = viz.PALETTES[scheme] || viz.PALETTES.map;
+  const tex = new THREE.DataTexture(new Uint8Array(pal.buffer.slice(0)), 256, 1, THREE.RGBAFormat);
+  tex.magFilter = tex.minFilter = THREE.NearestFilter; tex.needsUpdate = true;
+  return tex;
+}
+function updateMap(slot, d, L, info) {
+  const m = L.map;
+  if (!m) return;
+  const e = slotObject(slot, `map ${m.w} ${m.h} ${m.res} ${m.ox} ${m.oy} ${m.oyaw}`, () => {
+    const bytes = new Uint8Array(m.cells.buffer, m.cells.byteOffset, m.w * m.h);
+    const cells = new THREE.DataTexture(bytes, m.w, m.h, THREE.RedFormat, THREE.UnsignedByteType);
+    cells.magFilter = cells.minFilter = THREE.NearestFilter; cells.generateMipmaps = false;
+    cells.unpackAlignment = 1; cells.needsUpdate = true;
+    const mat = new THREE.ShaderMaterial({
+      uniforms: { cells: { value: cells }, palette: { value: paletteTexture(d.options.color_scheme) }, alpha: { value: 1 } },
+      vertexShader: MAP_VERTEX, fragmentShader: MAP_FRAGMENT, transparent: true, depthWrite: false, side: THREE.DoubleSide,
+    });
+    const plane = new THREE.Mesh(new THREE.PlaneGeometry(m.w * m.res, m.h * m.res), mat);
+    plane.position.set(m.w * m.res / 2, m.h * m.res / 2, 0);
+    const origin = new THREE.Group(); origin.add(plane);
+    origin.position.set(m.ox, m.oy, 0); origin.rotation.z = m.oyaw;
+    const g = new THREE.Group(); g.add(origin);
+    g.userData = { cells, mat, version: m.version, scheme: d.options.color_scheme };
+    return g;
+  });
+  const u = e.obj.userData;
+  if (u.version !== m.version) { u.cells.needsUpdate = true; u.version = m.version; }
+  if (u.scheme !== d.options.color_scheme) {
+    u.mat.uniforms.palette.value.dispose();
+    u.mat.uniforms.palette.value = paletteTexture(d.options.color_scheme);
+    u.scheme = d.options.color_scheme;
+  }
+  const alpha = Math.max(0, Math.min(1, d.options.alpha));
+  u.mat.uniforms.alpha.value = alpha;
+  u.mat.transparent = alpha < 1 || d.options.color_scheme === "costmap";
+  e.obj.children[0].children[0].renderOrder = d.options.draw_behind ? -2 : -1;
+  const p = frame3(info && info.frame ? info.frame : "map");
+  e.obj.visible = !!p;
+  if (p) setPose(e.obj, p);
+}
+
+const MAX_DRAWN_POINTS = 200000;
+function updatePoints(slot, d, L) {
+  if (!L.points) return;
+  const e = slotObject(slot, "points", () => {
+    const geo = new THREE.BufferGeometry();
+    const mat = new THREE.PointsMaterial({ size: 3, sizeAttenuation: false, vertexColors: true });
+    const pts = new THREE.Points(geo, mat); pts.frustumCulled = false;
+    return pts;
+  });
+  const now = performance.now(), decay = (d.options.decay_s || 0) * 1000;
+  if (decay > 0) L.points = L.points.filter((p, i) => i === L.points.length - 1 || now - p.t < decay);
+  const key = L.points.length + ":" + (L.version || 0);
+  e.obj.material.size = d.options.size_px || 3;
+  e.obj.material.transparent = d.options.alpha < 1;
+  if (e.drawn === key) return;
+  e.drawn = key;
+  let total = 0;
+  for (const s of L.points) total += s.n;
+  const step = Math.max(1, Math.ceil(total / MAX_DRAWN_POINTS));  // decimated for drawing
+  const n = Math.ceil(total / step), geo = e.obj.geometry;
+  if (!e.cap || e.cap < n) {  // buffers grow, then are rewritten in place (no re-allocation per scan)
+    e.cap = Math.max(n, 1024);
+    e.pos = new THREE.BufferAttribute(new Float32Array(e.cap * 3), 3).setUsage(THREE.DynamicDrawUsage);
+    e.rgb = new THREE.BufferAttribute(new Uint8Array(e.cap * 4), 4, true).setUsage(THREE.DynamicDrawUsage);
+    geo.setAttribute("position", e.pos); geo.setAttribute("color", e.rgb);
+  }
+  const pos = e.pos.array, rgb = e.rgb.array;
+  let k = 0, idx = 0;
+  for (const s of L.points) {
+    for (let i = 0; i < s.n; i++, idx++) {
+      if (idx % step) continue;
+      const a = i * s.stride;
+      pos[3 * k] = s.xyz[a]; pos[3 * k + 1] = s.xyz[a + 1]; pos[3 * k + 2] = s.stride === 3 ? s.xyz[a + 2] : 0;
+      rgb[4 * k] = s.rgba[4 * i]; rgb[4 * k + 1] = s.rgba[4 * i + 1]; rgb[4 * k + 2] = s.rgba[4 * i + 2]; rgb[4 * k + 3] = s.rgba[4 * i + 3];
+      k++;
+    }
+  }
+  e.pos.clearUpdateRanges(); e.pos.addUpdateRange(0, 3 * k); e.pos.needsUpdate = true;
+  e.rgb.clearUpdateRanges(); e.rgb.addUpdateRange(0, 4 * k); e.rgb.needsUpdate = true;
+  geo.setDrawRange(0, k);
+  e.obj.userData.count = k;
+}
+
+// URDF mesh visuals: STL (in the URDF material's colour) and COLLADA (its own materials),
+// fetched from the dashboard's /mesh/<visual index>, the files of the loaded model only
+const token = new URLSearchParams(location.search).get("token");
+const meshQuery = token ? "?token=" + encodeURIComponent(token) : "";
+viz.meshes = { loaded: 0, failed: 0 };
+function loadMesh(index, geometry, rgba, alpha) {
+  const holder = new THREE.Group();
+  holder.scale.set(...geometry.scale);
+  const url = `mesh/${index}${meshQuery}`, name = geometry.filename.toLowerCase();
+  const a = rgba[3] * alpha;
+  const done = (obj) => { holder.add(obj); viz.meshes.loaded += 1; };
+  const fail = (err) => { viz.meshes.failed += 1; console.warn("mesh", geometry.filename, err); };
+  if (name.endsWith(".stl")) {
+    new STLLoader().load(url, (geo) => {
+      geo.computeVertexNormals();
+      done(new THREE.Mesh(geo, new THREE.MeshLambertMaterial({ color: new THREE.Color(rgba[0], rgba[1], rgba[2]), transparent: a < 1, opacity: a })));
+    }, undefined, fail);
+  } else if (name.endsWith(".dae")) {
+    new ColladaLoader().load(url, (collada) => {
+      // the loader turns Z_UP files to three's y-up; ROS is z-up: undo it (and turn y-up files)
+      collada.scene.rotation.set(collada.scene.rotation.x !== 0 ? 0 : Math.PI / 2, 0, 0);
+      done(collada.scene);
+    }, undefined, fail);
+  } else fail("unsupported mesh format");
+  return holder;
+}
+
+function makeShape(geometry, rgba, alpha, index) {
+  let geo;
+  if (geometry.type === "mesh") return loadMesh(index, geometry, rgba, alpha);
+  if (geometry.type === "box") geo = new THREE.BoxGeometry(...geometry.size);
+  else if (geometry.type === "cylinder") {
+    geo = new THREE.CylinderGeometry(geometry.radius, geometry.radius, geometry.length, 24);
+    geo.rotateX(Math.PI / 2);  // three's cylinders run along y, URDF's along z
+  } else if (geometry.type === "sphere") geo = new THREE.SphereGeometry(geometry.radius, 20, 14);
+  else return null;
+  const a = rgba[3] * alpha;
+  const mat = new THREE.MeshLambertMaterial({ color: new THREE.Color(rgba[0], rgba[1], rgba[2]), transparent: a < 1, opacity: a });
+  return new THREE.Mesh(geo, mat);
+}
+function updateRobot(slot, d) {
+  const s = data.state;
+  if (!s || !s.robot3d) return;
+  const key = "robot " + JSON.stringify(s.robot3d) + d.options.alpha;
+  const e = slotObject(slot, key, () => {
+    const g = new THREE.Group();
+    for (const [i, v] of s.robot3d.entries()) {
+      const mesh = makeShape(v.geometry, v.rgba, d.options.alpha, i);
+      if (!mesh) continue;
+      const link = new THREE.Group(); link.userData.link = v.link; link.name = v.link;
+      setPose(mesh, v.origin); link.add(mesh); g.add(link);
+    }
+    return g;
+  });
+  for (const link of e.obj.children) {
+    const p = frame3(link.userData.link);
+    link.visible = !!p;
+    if (p) setPose(link, p);
+  }
+}
+
+const AXIS_COLOURS = [0xe62828, 0x28c828, 0x2850e6];
+function updateTf(slot, d) {
+  const s = data.state;
+  if (!s || !s.frames3) return;
+  const names = Object.keys(s.frames3).sort();
+  const len = 0.3 * d.options.scale;
+  const e = slotObject(slot, "tf " + names.join(",") + len, () => {
+    const g = new THREE.Group();
+    for (const name of names) {
+      const pts = [0, 0, 0, len, 0, 0, 0, 0, 0, 0, len, 0, 0, 0, 0, 0, 0, len], cols = [];
+      for (const c of AXIS_COLOURS) { const cc = new THREE.Color(c); cols.push(cc.r, cc.g, cc.b, cc.r, cc.g, cc.b); }
+      const geo = new THREE.BufferGeometry();
+      geo.setAttribute("position", new THREE.Float32BufferAttribute(pts, 3));
+      geo.setAttribute("color", new THREE.Float32BufferAttribute(cols, 3));
+      const axes = new THREE.LineSegments(geo, new THREE.LineBasicMaterial({ vertexColors: true, depthTest: false }));
+      axes.renderOrder = 10; axes.userData.frame = name; g.add(axes);
+    }
+    return g;
+  });
+  e.obj.visible = d.options.show_axes;
+  for (const axes of e.obj.children) setPose(axes, frame3(axes.userData.frame));
+  if (d.options.show_names) tfLabels.push(...names.map((n) => [n, s.frames3[n]]));
+}
+
+function arrowMesh(len, colour, alpha) {
+  const shaft = len * 0.77, head = len - shaft, r = Math.max(0.01, len * 0.025);
+  const mat = new THREE.MeshLambertMaterial({ color: colour, transparent: alpha < 1, opacity: alpha });
+  const a = new THREE.CylinderGeometry(r, r, shaft, 10); a.rotateZ(-Math.PI / 2); a.translate(shaft / 2, 0, 0);
+  const b = new THREE.ConeGeometry(r * 2.5, head, 12); b.rotateZ(-Math.PI / 2); b.translate(shaft + head / 2, 0, 0);
+  const g = new THREE.Group(); g.add(new THREE.Mesh(a, mat), new THREE.Mesh(b, mat));
+  return g;
+}
+function updatePoses(slot, d, L) {
+  const p = L.poses;
+  if (!p) return;
+  const o = d.options, key = `poses ${p.length} ${o.length} ${o.color} ${o.alpha}`;
+  const e = slotObject(slot, key, () => {
+    const g = new THREE.Group();
+    for (let i = 0; i < p.length; i += 3) g.add(arrowMesh(o.length, col(o.color), o.alpha));
+    return g;
+  });
+  e.obj.children.forEach((a, j) => { a.position.set(p[3 * j], p[3 * j + 1], 0.02); a.rotation.set(0, 0, p[3 * j + 2]); });
+}
+function updatePath(slot, d, L) {
+  const p = L.path;
+  if (!p) return;
+  const e = slotObject(slot, "path " + d.options.color, () => new THREE.Line(new THREE.BufferGeometry(),
+    new THREE.LineBasicMaterial({ color: col(d.options.color), transparent: true, opacity: d.options.alpha })));
+  if (e.path === p) return;
+  e.path = p;
+  const pts = new Float32Array(p.length / 2 * 3);
+  for (let i = 0, k = 0; i < p.length; i += 2, k += 3) { pts[k] = p[i]; pts[k + 1] = p[i + 1]; pts[k + 2] = 0.03; }
+  e.obj.geometry.setAttribute("position", new THREE.BufferAttribute(pts, 3));
+  e.obj.geometry.computeBoundingSphere();
+}
+function updateMarkers(slot, L) {
+  if (!L.markers) return;
+  const e = slotObject(slot, "markers", () => new THREE.Group());
+  if (e.items === L.markers) return;
+  e.items = L.markers;
+  for (const c of [...e.obj.children]) { e.obj.remove(c); dispose(c); }
+  for (const m of L.markers) {
+    const c = new THREE.Color(m.rgba[0], m.rgba[1], m.rgba[2]), a = m.rgba[3];
+    const v3 = m.points.map(([x, y]) => new THREE.Vector3(x, y, 0.04));
+    if (m.shape === "polygon" && v3.length > 2) {
+      const shape = new THREE.Shape(m.points.map(([x, y]) => new THREE.Vector2(x, y)));
+      const fill = new THREE.Mesh(new THREE.ShapeGeometry(shape), new THREE.MeshBasicMaterial({ color: c, transparent: true, opacity: a * 0.5, side: THREE.DoubleSide, depthWrite: false }));
+      fill.position.z = 0.04; e.obj.add(fill);
+      e.obj.add(new THREE.LineLoop(new THREE.BufferGeometry().setFromPoints(v3), new THREE.LineBasicMaterial({ color: c })));
+    } else if (m.shape === "polyline") {
+      e.obj.add(new THREE.Line(new THREE.BufferGeometry().setFromPoints(v3), new THREE.LineBasicMaterial({ color: c })));
+    } else if (m.shape === "lines") {
+      e.obj.add(new THREE.LineSegments(new THREE.BufferGeometry().setFromPoints(v3), new THREE.LineBasicMaterial({ color: c })));
+    } else if (m.shape === "points") {
+      e.obj.add(new THREE.Points(new THREE.BufferGeometry().setFromPoints(v3), new THREE.PointsMaterial({ color: c, size: Math.max(m.size, 0.02) })));
+    } else if (m.shape === "arrow") {
+      const ar = arrowMesh(m.length, c, a); ar.position.copy(v3[0]); ar.rotation.z = m.yaw; e.obj.add(ar);
+    } else if (m.shape === "text") {
+      tfText.push([m.text, v3[0]]);
+    }
+  }
+}
+
+// TF names as HTML labels, pushed apart so none overlap (rviz draws them over each other)
+let tfLabels = [];
+let tfText = [];
+const labelPool = [];
+function placeLabels(camera, w, h) {
+  const items = [];
+  const v = new THREE.Vector3();
+  for (const [name, p] of tfLabels) {
+    v.set(p[0], p[1], p[2]).project(camera);
+    if (v.z > 1 || v.z < -1) continue;
+    items.push({ name, x: (v.x + 1) / 2 * w + 6, y: (1 - v.y) / 2 * h - 14 });
+  }
+  items.sort((a, b) => a.y - b.y || a.x - b.x);
+  const placed = [];
+  for (const it of items) {
+    const width = 7 * it.name.length + 6, height = 14;
+    for (let tries = 0; tries < 40; tries++) {
+      const hit = placed.find((q) => it.x < q.x + q.w && q.x < it.x + width && it.y < q.y + q.h && q.y < it.y + height);
+      if (!hit) break;
+      it.y = hit.y + hit.h + 1;
+    }
+    placed.push({ x: it.x, y: it.y, w: width, h: height, name: it.name });
+  }
+  while (labelPool.length < placed.length) {
+    const el = document.createElement("div"); el.className = "tf-label";
+    el.style.cssText = "position:absolute;font:11px sans-serif;color:#fff;background:rgba(0,0,0,0.45);padding:0 3px;white-space:nowrap";
+    labels.appendChild(el); labelPool.push(el);
+  }
+  labelPool.forEach((el, i) => {
+    const q = placed[i];
+    if (!q) { el.style.display = "none"; return; }
+    el.style.display = "block"; el.textContent = q.name;
+    el.style.transform = `translate(${q.x.toFixed(0)}px, ${q.y.toFixed(0)}px)`;
+  });
+  viz.tfLabelBoxes = placed;
+}
+
+function updateScene() {
+  for (const o of objects.values()) o.seen = false;
+  tfLabels = []; tfText = [];
+  const cfg = data.config;
+  if (cfg) {
+    cfg.displays.forEach((d, slot) => {
+      if (!d.enabled) return;
+      const L = data.layers[slot] || {};
+      const info = data.state && data.state.displays ? data.state.displays[slot] : null;
+      switch (d.kind) {
+        case "grid": updateGrid(slot, d); break;
+        case "map": updateMap(slot, d, L, info); break;
+        case "laser_scan": case "point_cloud2": updatePoints(slot, d, L); break;
+        case "robot_model": updateRobot(slot, d); break;
+        case "tf": updateTf(slot, d); break;
+        case "odometry": case "pose": case "pose_array": updatePoses(slot, d, L); break;
+        case "path": updatePath(slot, d, L); break;
+        case "marker": case "marker_array": case "pose_with_covariance": case "polygon": updateMarkers(slot, L); break;
+        default: break;
+      }
+    });
+  }
+  for (const [slot, o] of objects) if (!o.seen) { scene.remove(o.obj); dispose(o.obj); objects.delete(slot); }
+}
+
+// ------------------------------------------------------------------ tools
+const toolArrow = arrowMesh(1, 0x50ff50, 1);
+toolArrow.visible = false; scene.add(toolArrow);
+const ground = new THREE.Plane(new THREE.Vector3(0, 0, 1), 0);
+const raycaster = new THREE.Raycaster();
+let camera = persp;
+function groundPoint(px, py) {
+  // the mouse ray cast onto the ground plane z = 0 of the fixed frame
+  const r = canvas.getBoundingClientRect();
+  const ndc = new THREE.Vector2((px - r.left) / r.width * 2 - 1, -((py - r.top) / r.height) * 2 + 1);
+  raycaster.setFromCamera(ndc, camera);
+  const hit = new THREE.Vector3();
+  return raycaster.ray.intersectPlane(ground, hit) ? hit : null;
+}
+viz.groundPoint = groundPoint;
+viz.worldToScreen3 = (x, y, z) => {
+  const r = canvas.getBoundingClientRect(), v = new THREE.Vector3(x, y, z).project(camera);
+  return [(v.x + 1) / 2 * r.width, (1 - v.y) / 2 * r.height];
+};
+
+let drag = null;
+canvas.addEventListener("contextmenu", (ev) => ev.preventDefault());
+canvas.addEventListener("mousedown", (ev) => {
+  canvas.focus();
+  const tool = viz.getTool();
+  if (tool !== "move" && ev.button === 0) {
+    const p = groundPoint(ev.clientX, ev.clientY);
+    if (!p) return;
+    drag = { tool, x: ev.clientX, y: ev.clientY, p, yaw: 0 };
+    return;
+  }
+  const mode = ev.button === 1 || (ev.button === 0 && ev.shiftKey) ? "pan" : ev.button === 2 ? "zoom" : "rotate";
+  drag = { tool: "camera", mode, x: ev.clientX, y: ev.clientY, cam: { ...cam, focal: cam.focal.clone() } };
+});
+window.addEventListener("mousemove", (ev) => {
+  if (!drag || cam.mode === "2D") return;
+  const dx = ev.clientX - drag.x, dy = ev.clientY - drag.y;
+  if (drag.tool !== "camera") {
+    const q = groundPoint(ev.clientX, ev.clientY);
+    if (q && Math.hypot(dx, dy) > 3) drag.yaw = Math.atan2(q.y - drag.p.y, q.x - drag.p.x);
+    return;
+  }
+  const c0 = drag.cam;
+  if (cam.mode === "TopDownOrtho") {
+    if (drag.mode === "rotate" && !ev.shiftKey && ev.buttons === 1) {  // left drag pans the top view
+      const c = Math.cos(cam.angle), s = Math.sin(cam.angle);
+      cam.x = c0.x - (c * dx + s * dy) / cam.scale; cam.y = c0.y - (s * dx - c * dy) / cam.scale;
+    } else if (drag.mode === "zoom") cam.scale = Math.max(0.5, c0.scale * Math.exp(-dy * 0.01));
+    else cam.angle = c0.angle + dx * 0.01;
+    return;
+  }
+  if (drag.mode === "rotate") {
+    cam.yaw = c0.yaw - dx * 0.01;
+    cam.pitch = Math.max(-1.55, Math.min(1.55, c0.pitch + dy * 0.01));
+  } else if (drag.mode === "zoom") {
+    cam.distance = Math.max(0.05, c0.distance * Math.exp(dy * 0.01));
+  } else {  // pan the focal point in the camera's plane
+    const k = cam.distance * 0.0015, right = new THREE.Vector3(), up = new THREE.Vector3();
+    right.setFromMatrixColumn(persp.matrixWorld, 0); up.setFromMatrixColumn(persp.matrixWorld, 1);
+    cam.focal.copy(c0.focal).addScaledVector(right, -dx * k).addScaledVector(up, dy * k);
+  }
+});
+window.addEventListener("mouseup", () => {
+  if (!drag) return;
+  const d = drag; drag = null;
+  if (d.tool === "goal" || d.tool === "initialpose") viz.send({ type: d.tool, x: d.p.x, y: d.p.y, yaw: d.yaw });
+  else if (d.tool === "point") viz.send({ type: "point", x: d.p.x, y: d.p.y });
+  if (d.tool !== "camera") viz.setTool("move");
+});
+canvas.addEventListener("wheel", (ev) => {
+  ev.preventDefault();
+  if (cam.mode === "TopDownOrtho") cam.scale = Math.min(2000, Math.max(0.5, cam.scale * Math.exp(-ev.deltaY * 0.001)));
+  else cam.distance = Math.max(0.05, cam.distance * Math.exp(ev.deltaY * 0.001));
+}, { passive: false });
+
+// ------------------------------------------------------------------- loop
+let fpsT0 = performance.now(), fpsN = 0;
+function frame() {
+  requestAnimationFrame(frame);
+  if (cam.mode === "2D") return;
+  const w = host.clientWidth, h = host.clientHeight;
+  const pr = renderer.getPixelRatio();
+  if (canvas.width !== Math.floor(w * pr) || canvas.height !== Math.floor(h * pr)) renderer.setSize(w, h, false);
+  const t0 = performance.now();
+  updateScene();
+  const t1 = performance.now();
+  camera = placeCamera(w, h);
+  if (drag && drag.tool !== "camera") {
+    const c = drag.tool === "goal" ? 0x50ff50 : drag.tool === "point" ? 0xffdc50 : 0x50a0ff;
+    toolArrow.visible = true; toolArrow.position.set(drag.p.x, drag.p.y, 0.05); toolArrow.rotation.set(0, 0, drag.yaw);
+    toolArrow.children.forEach((m) => m.material.color.setHex(c));
+  } else toolArrow.visible = false;
+  renderer.render(scene, camera);
+  const t2 = performance.now();
+  placeLabels(camera, w, h);
+  cam.msUpdate = 0.9 * (cam.msUpdate || 0) + 0.1 * (t1 - t0);
+  cam.msRender = 0.9 * (cam.msRender || 0) + 0.1 * (t2 - t1);
+  cam.frames += 1; fpsN += 1;
+  const now = performance.now();
+  if (now - fpsT0 >= 1000) {
+    cam.fps = fpsN * 1000 / (now - fpsT0); fpsN = 0; fpsT0 = now;
+    // adaptive resolution: a slow (software) renderer draws fewer pixels, down to half per
+    // axis, to keep the view interactive; back to full resolution when there is headroom
+    const r = cam.resolution;
+    if (!cam.adaptive) cam.resolution = 1;
+    else if (cam.fps < 28 && r > 0.5) cam.resolution = Math.max(0.5, r - 0.125);
+    else if (cam.fps > 50 && r < 1) cam.resolution = Math.min(1, r + 0.125);
+    if (cam.resolution !== r) renderer.setPixelRatio(cam.resolution * (window.devicePixelRatio || 1));
+  }
+}
+const sel = document.getElementById("view-mode");
+if (sel) sel.onchange = () => setMode(sel.value);
+requestAnimationFrame(frame);
