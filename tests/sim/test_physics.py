@@ -12,6 +12,7 @@ from roverlab.sim.collision import Obstacles, circle_polygon, inner_radius, poly
 from roverlab.sim.dynamics import (
     S_AL,
     S_CONTACT,
+    S_CONTACTS,
     S_EX,
     S_TH,
     S_TL,
@@ -127,6 +128,7 @@ def test_robot_stops_at_the_wall_and_ignores_low_mats() -> None:
     st[S_X] = 1.0
     _run(st, _params(), 100, walls=obs.segments, circles=obs.circles)
     assert st[S_CONTACT] == 1.0
+    assert st[S_CONTACTS] == 1.0  # pushing on for many steps is one event
     assert 1.84 < st[S_X] < 1.849  # the circumscribed 0.15 m footprint touches x = 2
     assert st[S_V] == pytest.approx(0.0, abs=1e-9)
     assert not obs.hits(FOOTPRINT, st[S_X], st[S_Y], st[S_TH])
@@ -134,6 +136,13 @@ def test_robot_stops_at_the_wall_and_ignores_low_mats() -> None:
     st[S_TL], st[S_TR] = -0.1, 0.1
     _run(st, _params(), 10, walls=obs.segments, circles=obs.circles)
     assert st[S_TH] > 0.05
+    # backing off and driving into the wall again is a second event
+    st[S_TL] = st[S_TR] = -0.5
+    _run(st, _params(), 20, walls=obs.segments, circles=obs.circles)
+    assert st[S_CONTACT] == 0.0
+    st[S_TL] = st[S_TR] = 1.0
+    _run(st, _params(), 100, walls=obs.segments, circles=obs.circles)
+    assert st[S_CONTACT] == 1.0 and st[S_CONTACTS] == 2.0
 
 
 def test_long_step_does_not_tunnel_through_a_wall() -> None:

@@ -16,6 +16,7 @@ from roverlab.cli import (
     explore,
     graph,
     launch,
+    nav,
     patrol,
     run,
     service,
@@ -70,6 +71,7 @@ slam_cli.app.command("mapeval")(slam_mapeval.mapeval)
 app.add_typer(slam_cli.app, name="slam")
 app.command("teleop")(teleop_cli.teleop)
 app.add_typer(amcl_run.app, name="amcl")
+app.add_typer(nav.app, name="nav")
 app.add_typer(bag_cli.app, name="bag")
 app.command("foxglove")(foxglove_cli.foxglove)
 

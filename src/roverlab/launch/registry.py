@@ -22,6 +22,7 @@ from roverlab.launch.devices import DEVICE_NODES
 from roverlab.launch.state import LaunchState, NodeFactory
 from roverlab.launch.xml import LaunchError, NodeSpec
 from roverlab.localization.amcl.node import AmclNode
+from roverlab.localization.fake_localization import FakeLocalization
 from roverlab.mapping.gmapping.node import SlamGMapping
 from roverlab.mapping.graph.node import SlamKarto, SlamToolbox
 from roverlab.mapping.hector.node import HectorMapping
@@ -311,6 +312,7 @@ REGISTRY[("slam_toolbox", "sync_slam_toolbox_node")] = _slam_node(SlamToolbox)
 REGISTRY[("slam_karto", "slam_karto")] = _slam_node(SlamKarto)
 REGISTRY[("costmap_2d", "costmap_2d_node")] = _slam_node(Costmap2DNode)
 REGISTRY[("amcl", "amcl")] = _slam_node(AmclNode)
+REGISTRY[("fake_localization", "fake_localization")] = _slam_node(FakeLocalization)
 REGISTRY[("move_base", "move_base")] = _slam_node(MoveBase)
 REGISTRY[("explore_lite", "explore")] = _slam_node(Explore)
 

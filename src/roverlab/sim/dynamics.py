@@ -6,7 +6,9 @@ moment in one call of :func:`advance`. The result is identical to ticking a 100 
 physics timer, without a Python callback per step.
 
 State vector layout (float64, see ``S_*``): ground-truth pose, wheel surface speeds and
-targets, wheel angles, encoder-odometry pose, body twist and forward acceleration.
+targets, wheel angles, encoder-odometry pose, body twist and forward acceleration, the
+contact flag of the last step and the number of contact events so far (a step in contact
+after one that was not).
 """
 
 from __future__ import annotations
@@ -26,7 +28,8 @@ S_AL, S_AR = 7, 8
 S_EX, S_EY, S_ETH = 9, 10, 11
 S_V, S_W, S_DV = 12, 13, 14
 S_CONTACT = 15
-STATE_SIZE = 16
+S_CONTACTS = 16
+STATE_SIZE = 17
 
 P_SEP, P_DIAM, P_ACC, P_SLIP, P_INNER = 0, 1, 2, 3, 4
 
@@ -94,7 +97,8 @@ def advance(
     ``noise`` holds pre-drawn standard normals (N, 2) for the wheel slip, consumed from
     ``noise_pos`` on (two per step while a wheel turns); returns the new position. A
     motion that would put the footprint into an obstacle stops at the contact (bisection
-    of the last clear sub-step) and sets ``state[S_CONTACT]``.
+    of the last clear sub-step) and sets ``state[S_CONTACT]``; a contact after a step
+    without one counts one event in ``state[S_CONTACTS]``.
     """
     sep = params[P_SEP]
     radius = 0.5 * params[P_DIAM]
@@ -174,5 +178,7 @@ def advance(
         state[S_DV] = (v - state[S_V]) / dt
         state[S_V] = v
         state[S_W] = w
+        if contact and state[S_CONTACT] == 0.0:
+            state[S_CONTACTS] += 1.0
         state[S_CONTACT] = 1.0 if contact else 0.0
     return noise_pos

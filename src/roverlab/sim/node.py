@@ -26,6 +26,7 @@ from roverlab.sim.dynamics import (
     S_AL,
     S_AR,
     S_CONTACT,
+    S_CONTACTS,
     S_DV,
     S_ETH,
     S_EX,
@@ -219,7 +220,15 @@ class SimulatorNode(Node):
 
     @property
     def contact(self) -> bool:
+        """The body touched an obstacle in the last physics step."""
         return bool(self._state[S_CONTACT])
+
+    @property
+    def contacts(self) -> int:
+        """Contact events so far: physics steps in contact after one that was not (a
+        robot pushing against a wall for a second is one event)."""
+        self.advance()
+        return int(self._state[S_CONTACTS])
 
     def advance(self) -> None:
         """Run every physics step up to the current clock time."""

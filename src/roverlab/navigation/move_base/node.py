@@ -34,6 +34,8 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import time
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -64,7 +66,7 @@ from roverlab.navigation.node_params import parameters_under
 from roverlab.navigation.planners import path_to_msg
 from roverlab.tf import Buffer, Throttle, TransformException, TransformListener
 
-__all__ = ["MoveBase"]
+__all__ = ["MoveBase", "TimingHook"]
 
 PLANNING, CONTROLLING, CLEARING = "PLANNING", "CONTROLLING", "CLEARING"
 PLANNING_R, CONTROLLING_R, OSCILLATION_R = "PLANNING_R", "CONTROLLING_R", "OSCILLATION_R"
@@ -87,6 +89,29 @@ def _quaternion_ok(q: Any) -> bool:
     x, y = (v / n)[:2]
     # the rotated z axis' z component: 1 - 2(x^2 + y^2)
     return abs((1.0 - 2.0 * (x * x + y * y)) - 1.0) < 1e-3
+
+
+#: ``hook(kind, wall_s, cpu_s, error)``: see ``MoveBase.timing_hook``
+TimingHook = Callable[[str, float, float, str | None], None]
+
+
+class _Timed:
+    """Times a block (wall and this thread's CPU time) for ``MoveBase.timing_hook``."""
+
+    __slots__ = ("cpu", "hook", "kind", "wall")
+
+    def __init__(self, hook: TimingHook | None, kind: str) -> None:
+        self.hook, self.kind = hook, kind
+        self.wall = self.cpu = 0.0
+
+    def __enter__(self) -> None:
+        if self.hook is not None:
+            self.wall, self.cpu = time.perf_counter(), time.thread_time()
+
+    def __exit__(self, _type: object, exc: BaseException | None, _tb: object) -> None:
+        if self.hook is not None:
+            wall, cpu = time.perf_counter() - self.wall, time.thread_time() - self.cpu
+            self.hook(self.kind, wall, cpu, None if exc is None else str(exc))
 
 
 class MoveBase(Node):
@@ -188,6 +213,11 @@ class MoveBase(Node):
         self.goals_succeeded = 0
         self.goals_aborted = 0
         self.last_result_text = ""
+        #: called as ``timing_hook(kind, wall_s, cpu_s, error)`` after every global
+        #: planner call (``"plan"``) and local planner call (``"control"``) of the action,
+        #: with its wall and CPU time; ``error`` is the failure's text (no plan, no valid
+        #: command) or None
+        self.timing_hook: TimingHook | None = None
         if p.shutdown_costmaps:
             self.global_costmap.stop()
             self.local_costmap.stop()
@@ -379,7 +409,8 @@ class MoveBase(Node):
             self._planning_retries += 1
             return False
         try:
-            path = self.planner.plan(gpose, self.goal, self.global_costmap.costmap)
+            with _Timed(self.timing_hook, "plan"):
+                path = self.planner.plan(gpose, self.goal, self.global_costmap.costmap)
         except GoalOutsideMapBoundsError as err:
             if not self.global_costmap.layered.rolling_window:
                 self._abort(f"Aborting on goal because it is outside the global costmap: {err}")
@@ -428,9 +459,10 @@ class MoveBase(Node):
             if lpose is None:
                 raise ControllerError("no robot pose in the local costmap's frame")
             local_plan = self._plan_in_local_frame()
-            cmd = self.controller.compute_velocity(
-                lpose, self._twist, local_plan, self.local_costmap.costmap
-            )
+            with _Timed(self.timing_hook, "control"):
+                cmd = self.controller.compute_velocity(
+                    lpose, self._twist, local_plan, self.local_costmap.costmap
+                )
         except (ControllerError, NavigationError, TransformException) as err:
             self._throttle.warning(
                 "control", f"The local planner could not find a valid plan: {err}"

@@ -24,6 +24,7 @@ _jit = numba.njit(cache=True, nogil=True)
 POT_HIGH = 1.0e10
 COST_OBS = 254
 COST_NEUTRAL = 50
+_OSC_TOL = 0.25  # cells: the path's oscillation test
 INVSQRT2 = 0.707106781
 
 
@@ -253,8 +254,9 @@ def calc_path(
     the potential's zero at ``(end_x, end_y)``, steps of half a cell (navfn's ``calcPath``
     and global_planner's ``GradientPath``).
 
-    Where one of the 8 neighbours is unreached (or the path oscillates) it steps to the
-    lowest neighbour instead. ``navfn_stop``: stop when the nearest cell's potential is
+    Where one of the 8 neighbours is unreached (or the path oscillates: a point within a
+    quarter of a cell of the one two steps back) it steps to the lowest neighbour
+    instead. ``navfn_stop``: stop when the nearest cell's potential is
     below ``COST_NEUTRAL`` (navfn); otherwise when within half a cell of the end
     (global_planner) or in the end's cell (global_planner's test alone misses an end in
     the upper half of its cell when the descent arrives at the cell's corner). Writes
@@ -293,10 +295,14 @@ def calc_path(
         out[npath, 0] = stc % nx + dx
         out[npath, 1] = stc // nx + dy
         npath += 1
+        # navfn / global_planner test for exact equality; a descent caught between two
+        # points (a saddle of the potential, near the start's 2 x 2 block) repeats them
+        # only approximately, for dozens of cycles, each one a zig-zag in the plan; two
+        # half-cell steps of a real descent are about a cell apart
         osc = (
             npath > 2
-            and out[npath - 1, 0] == out[npath - 3, 0]
-            and out[npath - 1, 1] == out[npath - 3, 1]
+            and abs(out[npath - 1, 0] - out[npath - 3, 0]) < _OSC_TOL
+            and abs(out[npath - 1, 1] - out[npath - 3, 1]) < _OSC_TOL
         )
         stcnx = stc + nx
         stcpx = stc - nx

@@ -61,8 +61,18 @@ class TimedElasticBand:
         estimate_orient: bool,
         min_samples: int,
         guess_backwards: bool,
+        min_spacing: float = 0.0,
     ) -> None:
-        """TEB's ``initTrajectoryToGoal`` from a plan (start and goal poses included)."""
+        """TEB's ``initTrajectoryToGoal`` from a plan (start and goal poses included).
+
+        ``min_spacing`` (m): intermediate plan points closer than this to the last pose
+        taken are skipped, and the headings point at the next point taken. The planner
+        passes the distance of the shortest interval ``autoResize`` keeps, so the band
+        starts as it would end up after resizing, without the headings of sub-resolution
+        wiggles of the plan (a gradient descent's zig-zag of a few centimetres makes every
+        other heading turn by pi: seconds of rotation per interval, which ``autoResize``
+        then splits into hundreds of poses). 0 takes every point, as TEB.
+        """
         start = plan[0].copy()
         goal = plan[-1].copy()
         poses = [start]
@@ -71,9 +81,16 @@ class TimedElasticBand:
         if guess_backwards:
             d = goal[:2] - start[:2]
             backwards = float(d @ [math.cos(start[2]), math.sin(start[2])]) < 0
+        taken = [0]
         for i in range(1, len(plan) - 1):
+            last = plan[taken[-1]]
+            if math.hypot(plan[i, 0] - last[0], plan[i, 1] - last[1]) >= min_spacing:
+                taken.append(i)
+        taken.append(len(plan) - 1)
+        for k in range(1, len(taken) - 1):
+            i, j = taken[k], (taken[k] + 1 if min_spacing <= 0 else taken[k + 1])
             if estimate_orient:
-                yaw = math.atan2(plan[i + 1, 1] - plan[i, 1], plan[i + 1, 0] - plan[i, 0])
+                yaw = math.atan2(plan[j, 1] - plan[i, 1], plan[j, 0] - plan[i, 0])
                 if backwards:
                     yaw = wrap_angle(yaw + math.pi)
             else:

@@ -27,7 +27,6 @@ __all__ = [
     "build_structure",
     "evaluate",
     "robot_distance",
-    "scatter_transposed",
 ]
 
 _jit = numba.njit(cache=True, nogil=True)
@@ -394,18 +393,3 @@ def associate_obstacles(
             out_obst[cnt] = right
             cnt += 1
     return cnt
-
-
-@_jit
-def scatter_transposed(
-    jdata: NDArray[np.float64],
-    indices: NDArray[np.int64],
-    indptr: NDArray[np.int64],
-    out: NDArray[np.float64],
-) -> None:
-    """The CSR Jacobian written into ``out`` as its transpose ``(nvar, nres)`` (the
-    column-major layout MINPACK reads without a copy)."""
-    out[:] = 0.0
-    for row in range(indptr.shape[0] - 1):
-        for k in range(indptr[row], indptr[row + 1]):
-            out[indices[k], row] = jdata[k]

@@ -16,11 +16,10 @@ Per control cycle, as TebLocalPlannerROS::computeVelocityCommands:
   and goal updated; re-initialised when the goal moved more than
   ``force_reinit_new_goal_dist`` / ``_angular``), then ``no_outer_iterations`` times:
   resized (``teb_autosize``, ``dt_ref``, ``dt_hysteresis``), obstacles associated to poses,
-  and optimised as a nonlinear least-squares problem by Levenberg-Marquardt (TEB runs g2o's
-  LM for ``no_inner_iterations`` iterations; here MINPACK's ``lmder`` through scipy's
-  ``leastsq``, the same routine as ``least_squares(method="lm")`` with less overhead, with
-  ``no_inner_iterations + 2`` cost evaluations, the Jacobian assembled by the compiled
-  kernel); the obstacle weight grows by ``weight_adapt_factor`` each time;
+  and optimised as a sparse nonlinear least-squares problem by g2o's Levenberg-Marquardt
+  for ``no_inner_iterations`` iterations (:mod:`.solver`: the normal equations of the
+  chain are banded, factorised in time linear in the band's length); the obstacle weight
+  grows by ``weight_adapt_factor`` each time;
 * the first ``feasibility_check_no_poses`` poses are checked against the costmap with the
   costmap's footprint; the command is the velocity between the first pose and the next
   (``control_look_ahead_poses``), saturated to the limits.
@@ -31,12 +30,9 @@ Failures raise :class:`NoValidControlError` and reset the band, as TEB clears it
 from __future__ import annotations
 
 import math
-import warnings
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.optimize import leastsq
-from threadpoolctl import ThreadpoolController
 
 from roverlab.geometry import SE2, wrap_angle
 from roverlab.navigation.controllers.base import Velocity2D, angle_diff, as_plan, stopped
@@ -45,9 +41,9 @@ from roverlab.navigation.controllers.teb.kernels import (
     associate_obstacles,
     build_structure,
     evaluate,
-    scatter_transposed,
 )
 from roverlab.navigation.controllers.teb.params import TebParams
+from roverlab.navigation.controllers.teb.solver import band_order, levenberg_marquardt
 from roverlab.navigation.costmap.costmap_2d import LETHAL_OBSTACLE, Costmap2D
 from roverlab.navigation.costmap.footprint import footprint_radii
 from roverlab.navigation.costmap.kernels import bresenham, line_cost
@@ -56,11 +52,6 @@ from roverlab.navigation.errors import InvalidPathError, NoValidControlError
 __all__ = ["TebPlanner"]
 
 _DT_MIN = 1e-3  # floor of every time difference after a solve
-# MINPACK's QR goes through LAPACK: on one BLAS thread it is faster for these small
-# matrices, never stalls on a busy machine, and gives the same bits every run
-_BLAS = ThreadpoolController()
-# typical size of a step in x, y (m), theta (rad) and dt (s): the solver's variable scale
-_SCALE = np.array([0.1, 0.1, 0.2, 0.1])
 
 
 def _prune(pose: SE2, plan: NDArray[np.float64], dist_behind: float) -> NDArray[np.float64]:
@@ -156,6 +147,12 @@ class TebPlanner:
         self._last_pose: SE2 | None = None
         self._last_twist = Velocity2D()
         self._line_buf = np.empty((4096, 2), dtype=np.int64)
+
+    @property
+    def trajectory(self) -> NDArray[np.float64]:
+        """The optimised band's poses ``(N, 3)`` (what TebLocalPlannerROS publishes as
+        ``local_plan``); empty after a failed cycle."""
+        return self.band.poses
 
     # ------------------------------------------------------------------ plan / goal
     def set_plan(self, plan: ArrayLike) -> None:
@@ -342,34 +339,17 @@ class TebPlanner:
             et, pi, di, ax, sw = self._graph(mult, start_vel, free_goal)
             indptr, indices, _row0 = build_structure(et, pi, di, n)
             nres = int(indptr.shape[0] - 1)
-            nvar = 3 * (n - 2) + (n - 1)
+            x0 = np.concatenate([poses[1:-1].ravel(), dts])
             r = np.empty(nres)
             jdata = np.empty(indices.shape[0])
 
-            x0 = np.concatenate([poses[1:-1].ravel(), dts])
+            def fun(
+                x: NDArray[np.float64], want_jac: bool
+            ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+                evaluate(x, poses, dts, et, pi, di, ax, sw, cfg, model, mp, want_jac, r, jdata)  # noqa: B023
+                return r, jdata  # noqa: B023
 
-            # the unknowns are offsets from the current band (so that the solver's first
-            # trust region, set from the norm of the start point, is one scaled unit)
-            def fun(d: NDArray[np.float64]) -> NDArray[np.float64]:
-                evaluate(x0 + d, poses, dts, et, pi, di, ax, sw, cfg, model, mp, False, r, jdata)  # noqa: B023
-                return r.copy()  # noqa: B023
-
-            jt = np.zeros((nvar, nres))
-
-            def jac(d: NDArray[np.float64]) -> NDArray[np.float64]:
-                evaluate(x0 + d, poses, dts, et, pi, di, ax, sw, cfg, model, mp, True, r, jdata)  # noqa: B023
-                scatter_transposed(jdata, indices, indptr, jt)  # noqa: B023
-                return jt  # noqa: B023
-
-            scale = np.concatenate([np.tile(_SCALE[:3], n - 2), np.full(n - 1, _SCALE[3])])
-            with warnings.catch_warnings():
-                # leastsq warns when it stops at maxfev: that is the iteration budget
-                warnings.simplefilter("ignore", RuntimeWarning)
-                sol, _ier = leastsq(
-                    fun, np.zeros(nvar), Dfun=jac, col_deriv=True,
-                    maxfev=p.no_inner_iterations + 2, diag=1.0 / scale,
-                )  # fmt: skip
-            x = x0 + np.asarray(sol, dtype=np.float64)
+            x = levenberg_marquardt(x0, fun, indices, indptr, band_order(n), p.no_inner_iterations)
             self.band.poses[1:-1] = x[: 3 * (n - 2)].reshape(-1, 3)
             self.band.poses[1:-1, 2] = wrap_angle(self.band.poses[1:-1, 2])
             # g2o bounds no variable either; a time difference must stay positive
@@ -525,13 +505,13 @@ class TebPlanner:
             band.update_and_prune(start, goal, p.min_samples)
         else:
             band.clear()
+            spacing = (p.dt_ref - p.dt_hysteresis) * p.max_vel_x if p.teb_autosize else 0.0
             band.init_from_plan(
                 local, p.max_vel_x, p.max_vel_theta, p.global_plan_overwrite_orientation,
-                p.min_samples, p.allow_init_with_backwards_motion,
+                p.min_samples, p.allow_init_with_backwards_motion, max(spacing, 0.0),
             )  # fmt: skip
         try:
-            with _BLAS.limit(limits=1, user_api="blas"):
-                self._optimize(twist, p.free_goal_vel)
+            self._optimize(twist, p.free_goal_vel)
         except (ValueError, TypeError, np.linalg.LinAlgError) as err:
             band.clear()
             raise NoValidControlError(

@@ -1,0 +1,71 @@
+"""``roverlab nav``: navigation tools; ``roverlab nav bench`` is the navigation benchmark."""
+
+from __future__ import annotations
+
+import logging
+import signal
+import sys
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from roverlab.navbench import LOCALIZATIONS, PLANNERS, BenchConfig, run_bench
+
+__all__ = ["app", "bench"]
+
+app = typer.Typer(
+    name="nav",
+    help="Navigation (move_base) tools: the benchmark.",
+    no_args_is_help=True,
+    pretty_exceptions_enable=False,
+    context_settings={"help_option_names": ["-h", "--help"]},
+)
+
+
+@app.command("bench")
+def bench(
+    out: Annotated[Path, typer.Option("--out", help="Output folder: bench.json, bench.png.")],
+    world: Annotated[
+        str, typer.Option("--world", help="Bundled world (maze, office, house) or a world file.")
+    ] = "maze",
+    robot: Annotated[str, typer.Option("--robot", help="Bundled robot or URDF/xacro.")] = "mybot",
+    map_yaml: Annotated[
+        Path | None,
+        typer.Option("--map", help="Map YAML for map_server and amcl (default: from the world)."),
+    ] = None,
+    planner: Annotated[
+        str, typer.Option("--planner", help=f"Local planner: {', '.join(PLANNERS)}.")
+    ] = "dwa",
+    localization: Annotated[
+        str, typer.Option("--localization", help=f"{', '.join(LOCALIZATIONS)}.")
+    ] = "amcl",
+    goals: Annotated[int, typer.Option("--goals", help="Number of goals.")] = 100,
+    seed: Annotated[int, typer.Option("--seed", help="Seed of goals, simulator, amcl.")] = 0,
+    goal_timeout: Annotated[
+        float | None,
+        typer.Option(
+            "--goal-timeout",
+            help="Per-goal timeout, simulated s (default: 60 + 5 per metre of shortest path).",
+        ),
+    ] = None,
+    params: Annotated[
+        Path | None,
+        typer.Option("--params", help="Folder of robot_navigation parameter files."),
+    ] = None,
+    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No per-goal lines.")] = False,
+) -> None:
+    """Run simulator + map_server + amcl + move_base on seeded random goals, as fast as
+    the CPU allows; print one summary line (per-goal lines go to stderr)."""
+    logging.getLogger("roverlab").setLevel(logging.ERROR)
+    report = run_bench(
+        BenchConfig(
+            world=world, out=out, robot=robot, map_yaml=map_yaml, planner=planner,
+            localization=localization, goals=goals, seed=seed, goal_timeout_s=goal_timeout,
+            params_dir=params,
+        ),
+        log=(lambda _l: None) if quiet else (lambda line: print(line, file=sys.stderr)),
+    )  # fmt: skip
+    print(report.summary_line())
+    if report.interrupted:
+        raise typer.Exit(128 + signal.Signals[report.interrupted].value)
