@@ -109,3 +109,25 @@ def test_cli_refuses_a_paced_batch(tmp_path: Path) -> None:
     r = _explore_cli(tmp_path, "--rate", "2")
     assert r.returncode == 2
     assert r.stderr.strip().splitlines()[-1].endswith("--episodes/--workers run at --rate max only")
+
+
+def test_nav_bench_episodes_are_its_single_runs(tmp_path: Path) -> None:
+    args = ["nav", "bench", "--world", "maze", "--goals", "1", "--seed", "3", "--quiet"]
+    batch = subprocess.run(
+        [sys.executable, "-m", "roverlab.cli", *args, "--episodes", "2", "--out",
+         str(tmp_path / "b")], capture_output=True, text=True, timeout=600,
+    )  # fmt: skip
+    assert batch.returncode == 0, batch.stderr
+    rows = json.loads((tmp_path / "b" / "episodes.json").read_text())["episodes"]
+    assert [r["seed"] for r in rows] == [3, 4] and all(r["goals"] == 1 for r in rows)
+    single = subprocess.run(
+        [sys.executable, "-m", "roverlab.cli", *args[:-3], "--seed", "4", "--out",
+         str(tmp_path / "s")], capture_output=True, text=True, timeout=600,
+    )  # fmt: skip
+    assert single.returncode == 0, single.stderr
+    one = json.loads((tmp_path / "s" / "bench.json").read_text())
+    timing = ("wall", "_ms", "map", "machine")
+    assert {k: v for k, v in one.items() if k in rows[1] and not any(t in k for t in timing)} == {
+        k: v for k, v in rows[1].items() if k in one and not any(t in k for t in timing)
+    }
+    assert (tmp_path / "b" / "episode_001" / "bench.json").is_file()

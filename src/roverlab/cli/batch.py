@@ -14,7 +14,14 @@ import typer
 from roverlab.batch import Episode, EpisodeFn, run_batch, write_batch_outputs
 from roverlab.cli.common import stop_on_signals
 
-__all__ = ["run_episodes"]
+__all__ = ["absolute", "run_episodes"]
+
+
+def absolute(name_or_path: str) -> str:
+    """A bundled name as it is; an existing file as an absolute path (a Ray worker may run
+    in another folder, or on another machine with the same files)."""
+    path = Path(name_or_path)
+    return str(path.resolve()) if path.exists() else name_or_path
 
 
 def _line(episode: Episode, done: int, total: int) -> str:
@@ -24,7 +31,7 @@ def _line(episode: Episode, done: int, total: int) -> str:
     shown = ", ".join(
         f"{k} {v:.4g}" if isinstance(v, float) else f"{k} {v}"
         for k, v in row.items()
-        if k not in ("episode", "seed") and isinstance(v, (int, float, str)) and k != "world"
+        if k not in ("episode", "seed") and isinstance(v, (int, float)) and not isinstance(v, bool)
     )
     return f"[{done}/{total}] episode {row['episode']} (seed {row['seed']}): {shown}"
 

@@ -12,7 +12,7 @@ import typer
 from roverlab.autonomy.explore_batch import PLOT_COLUMNS, explore_episode
 from roverlab.autonomy.explore_run import run_explore, write_explore_outputs
 from roverlab.autonomy.stack import SLAM_METHODS, AutonomyError
-from roverlab.cli.batch import run_episodes
+from roverlab.cli.batch import absolute, run_episodes
 from roverlab.cli.common import stop_on_signals
 from roverlab.cli.sim import parse_rate
 from roverlab.core import configure_logging
@@ -91,7 +91,8 @@ def explore(
         if not math.isinf(pace):
             raise AutonomyError("--episodes/--workers run at --rate max only")
         config = {
-            "world": world, "robot": robot, "slam": slam, "duration_s": duration,
+            "world": absolute(world), "robot": absolute(robot), "slam": slam,
+            "duration_s": duration,
             "spawn": [x, y, yaw],
         }  # fmt: skip
         run_episodes(

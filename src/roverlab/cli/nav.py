@@ -10,7 +10,9 @@ from typing import Annotated
 
 import typer
 
+from roverlab.cli.batch import absolute, run_episodes
 from roverlab.navbench import LOCALIZATIONS, PLANNERS, BenchConfig, run_bench
+from roverlab.navbench.batch import PLOT_COLUMNS, nav_episode
 
 __all__ = ["app", "bench"]
 
@@ -54,10 +56,58 @@ def bench(
         typer.Option("--params", help="Folder of robot_navigation parameter files."),
     ] = None,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No per-goal lines.")] = False,
+    episodes: Annotated[
+        int,
+        typer.Option(
+            "--episodes",
+            help="Run this many episodes; episode i uses seed SEED+i. More than one writes "
+            "OUT/episodes.json, episodes.csv, episodes.png and OUT/episode_NNN/.",
+        ),
+    ] = 1,
+    workers: Annotated[
+        int,
+        typer.Option(
+            "--workers",
+            help="Episodes run in parallel on this many CPUs (a local Ray instance; "
+            "needs the 'ray' extra). 1: one after the other, no Ray.",
+        ),
+    ] = 1,
+    ray_address: Annotated[
+        str | None,
+        typer.Option(
+            "--ray-address",
+            help="Run the episodes on this running Ray cluster (e.g. ray://head:10001 or "
+            "auto); see docs/scale.md.",
+        ),
+    ] = None,
 ) -> None:
     """Run simulator + map_server + amcl + move_base on seeded random goals, as fast as
     the CPU allows; print one summary line (per-goal lines go to stderr)."""
     logging.getLogger("roverlab").setLevel(logging.ERROR)
+    if episodes != 1 or workers != 1 or ray_address is not None:
+        BenchConfig(
+            world=world,
+            out=out,
+            robot=robot,
+            map_yaml=map_yaml,
+            planner=planner,
+            localization=localization,
+            goals=goals,
+            goal_timeout_s=goal_timeout,
+            params_dir=params,
+        ).validate()  # bad options: one line before any episode starts
+        config: dict[str, object] = {
+            "world": absolute(world), "robot": absolute(robot), "planner": planner,
+            "localization": localization, "goals": goals, "goal_timeout_s": goal_timeout,
+            "map_yaml": str(map_yaml.resolve()) if map_yaml else None,
+            "params_dir": str(params.resolve()) if params else None,
+        }  # fmt: skip
+        run_episodes(
+            nav_episode, config, episodes=episodes, seed=seed, workers=workers,
+            address=ray_address, out=out, plot=PLOT_COLUMNS,
+            title=f"nav bench {Path(world).stem} / {planner}: {episodes} episodes",
+        )  # fmt: skip
+        return
     report = run_bench(
         BenchConfig(
             world=world, out=out, robot=robot, map_yaml=map_yaml, planner=planner,
