@@ -50,8 +50,10 @@ class RunMonitor(Node):
 
     Attributes:
         coverage: one :class:`CoverageSample` per map message.
-        contacts: contact events seen (a step in contact after one that was not).
-        contact_events: when and where each began: ``(t, x, y, yaw)`` in the world.
+        contacts: contact events (the simulator's count: a physics step in contact after
+            one that was not).
+        contact_events: when and where each began, to the sample (0.1 s) after it:
+            ``(t, x, y, yaw)`` in the world.
     """
 
     def __init__(
@@ -88,12 +90,14 @@ class RunMonitor(Node):
         """Record the robot's true pose now (and whether it touches something)."""
         sim = self.simulation.simulator
         sim.advance()
-        contact = sim.contact
         t = self.get_clock().now_ns() / 1e9
-        if contact and not self._in_contact:
-            self.contacts += 1
+        # the simulator counts contact events at its physics rate (100 Hz); a sample (10 Hz)
+        # places the ones that began since the last sample
+        count = sim.contacts
+        for _ in range(count - self.contacts):
             self.contact_events.append((t, sim.x, sim.y, sim.yaw))
-        self._in_contact = contact
+        self.contacts = count
+        self._in_contact = sim.contact
         self._path.t.append(t)
         self._path.xy.append((sim.x, sim.y, sim.yaw))
 
