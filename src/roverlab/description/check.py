@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import math
 
+from roverlab.description.errors import DescriptionError
 from roverlab.description.gazebo import (
     CameraPluginSpec,
     DiffDriveSpec,
@@ -27,7 +28,8 @@ from roverlab.description.gazebo import (
     KinectPluginSpec,
     LaserPluginSpec,
 )
-from roverlab.description.model import RobotModel
+from roverlab.description.meshes import mesh_points
+from roverlab.description.model import Mesh, RobotModel
 
 __all__ = ["format_check", "format_tree", "robot_warnings"]
 
@@ -44,11 +46,36 @@ def robot_warnings(model: RobotModel) -> list[str]:
         out.append(f"{src}: Gazebo plugins not simulated (ignored): {', '.join(plugins)}")
     if sensors:
         out.append(f"{src}: Gazebo sensor types not simulated (ignored): {', '.join(sensors)}")
+    out += _shape_warnings(model)
     unknown = [r for r in model.gazebo.references if r not in model.links and r not in model.joints]
     if unknown:
         out.append(
             f"{src}: <gazebo reference> names no link or joint (ignored): "
             + ", ".join(f"'{r}'" for r in unknown)
+        )
+    return out
+
+
+def _shape_warnings(model: RobotModel) -> list[str]:
+    """Meshes the simulator cannot read, and a robot left with no shape at all."""
+    out: list[str] = []
+    use_collisions = any(link.collisions for link in model.links.values())
+    usable = 0
+    for name, link in model.links.items():
+        for shape in link.collisions if use_collisions else link.visuals:
+            geom = shape.geometry
+            if not isinstance(geom, Mesh):
+                usable += 1
+                continue
+            try:
+                mesh_points(geom, model.source)
+                usable += 1
+            except DescriptionError as err:
+                out.append(f"{model.source}: link '{name}': mesh left out of the body: {err}")
+    if not usable:
+        out.append(
+            f"{model.source}: no {'collision' if use_collisions else 'visual'} shape the "
+            "simulator can use: the body is a 0.2 m square"
         )
     return out
 
@@ -160,5 +187,5 @@ def format_check(model: RobotModel) -> str:
             "warning: <gazebo reference> names no link or joint: "
             + ", ".join(f"'{r}'" for r in unknown)
         )
-    lines.extend(f"warning: {w}" for w in model.warnings)
+    lines.extend(f"warning: {w}" for w in [*model.warnings, *_shape_warnings(model)])
     return "\n".join(lines)

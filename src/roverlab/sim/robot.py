@@ -22,6 +22,8 @@ from roverlab.description import (
     Sphere,
 )
 from roverlab.description.errors import DescriptionError
+from roverlab.description.meshes import mesh_points
+from roverlab.description.model import Mesh
 from roverlab.geometry import Transform3
 from roverlab.sim.config import (
     CameraSensor,
@@ -39,8 +41,9 @@ __all__ = ["sim_config_from_model"]
 F64 = NDArray[np.float64]
 
 
-def _geometry_points(geom: object) -> F64:
-    """Sample points on a geometry's surface, in its own frame."""
+def _geometry_points(geom: object, source: str = "<string>") -> F64:
+    """Sample points on a geometry's surface, in its own frame (a mesh: its parts' hull
+    vertices; none when the file cannot be read, which ``robot_warnings`` reports)."""
     if isinstance(geom, Box):
         sx, sy, sz = (0.5 * v for v in geom.size)
         return np.array(
@@ -57,7 +60,12 @@ def _geometry_points(geom: object) -> F64:
         r = geom.radius
         ring = np.stack([r * np.cos(a), r * np.sin(a), np.zeros(16)], axis=1)
         return np.vstack([ring, [[0, 0, r], [0, 0, -r]]])
-    return np.zeros((0, 3))  # meshes: no shape information without loading the mesh
+    if isinstance(geom, Mesh):
+        try:
+            return mesh_points(geom, source)
+        except DescriptionError:
+            return np.zeros((0, 3))
+    return np.zeros((0, 3))
 
 
 def _body_points(model: RobotModel, base: str) -> F64:
@@ -69,7 +77,7 @@ def _body_points(model: RobotModel, base: str) -> F64:
     for name, link in model.links.items():
         shapes = link.collisions if use_collisions else link.visuals
         for shape in shapes:
-            local = _geometry_points(shape.geometry)
+            local = _geometry_points(shape.geometry, model.source)
             if len(local):
                 pts.append((base_inv * poses[name] * shape.origin).apply(local))
     return np.vstack(pts) if pts else np.zeros((0, 3))
