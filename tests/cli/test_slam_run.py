@@ -156,6 +156,28 @@ def test_graph_parameter_errors_come_before_reading_the_log(tmp_path: Path) -> N
     assert "no_such_thing" in r.stderr and len(r.stderr.strip().splitlines()) == 1
 
 
+def test_graph_node_settings_are_named_as_ignored_offline() -> None:
+    from roverlab.cli.slam_run import run_graph
+    from roverlab.geometry import SE2
+    from roverlab.slam.logs import LaserLog, ScanRecord
+
+    beams = np.linspace(-1.5, 1.5, 181)
+    recs = [
+        ScanRecord(timestamp=float(i), ranges=np.full(beams.size, 3.0, np.float32),
+                   angle_min=float(beams[0]), angle_increment=float(beams[1] - beams[0]),
+                   range_min=0.0, range_max=30.0, odom_pose=SE2(0.1 * i, 0.0, 0.0))
+        for i in range(3)
+    ]  # fmt: skip
+    params = {"minimum_time_interval": 0.5, "use_scan_barycenter": True, "mode": "mapping",
+              "resolution": 0.05}  # fmt: skip
+    notes = run_graph(LaserLog(recs), params).notes
+    assert notes[-1] == (
+        "warning: slam_toolbox node parameters have no effect on an offline run (ignored): "
+        "minimum_time_interval, mode, use_scan_barycenter"
+    )
+    assert not any("ignored" in n for n in run_graph(LaserLog(recs), {"resolution": 0.05}).notes)
+
+
 @pytest.mark.parametrize("method", ["hector", "gmapping", "graph"])
 def test_a_simulator_recording_maps_the_maze(tmp_path: Path, method: str) -> None:
     """A recording of ``roverlab sim`` (odometry from TF) -> ``slam run`` -> ``slam mapeval``."""

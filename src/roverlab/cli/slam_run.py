@@ -25,6 +25,7 @@ from roverlab.cli.log_input import (
 )
 from roverlab.mapping.gmapping import GMapping, GMappingParams
 from roverlab.mapping.graph import GraphParams, GraphSLAM
+from roverlab.mapping.graph.params import NODE_PARAMETERS
 from roverlab.mapping.hector import HectorParams, HectorSLAM
 from roverlab.maps import save_map
 from roverlab.maps.plot import write_map_png
@@ -46,6 +47,12 @@ def run_graph(records: LaserLog, params: dict[str, object]) -> MethodResult:
     m = result.map
     g = slam.graph()
     notes = [f"graph: {g.num_vertices} keyframes, {g.num_edges} constraints"]
+    dropped = sorted(k for k in params if k in NODE_PARAMETERS)
+    if dropped:  # GraphParams.from_ros accepts slam_toolbox's node settings and drops them
+        notes.append(
+            "warning: slam_toolbox node parameters have no effect on an offline run "
+            f"(ignored): {', '.join(dropped)}"
+        )
     return MethodResult(m.data, m.resolution, m.origin, result.poses, result.trajectory, notes)
 
 
