@@ -309,3 +309,51 @@ def test_imu_plugin_frame_defaults_to_body_and_needs_a_body() -> None:
                 "<bodyName>ghost</bodyName></plugin></gazebo>"
             )
         )
+
+
+def _drive(extra: str, mass: float | None) -> str:
+    inertial = (
+        f'<inertial><mass value="{mass}"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" '
+        'izz="1"/></inertial>'
+        if mass is not None
+        else ""
+    )
+    return (
+        f'<robot name="r"><link name="base">{inertial}</link><link name="lw"/><link name="rw"/>'
+        '<joint name="left_joint" type="continuous"><parent link="base"/><child link="lw"/>'
+        '</joint><joint name="right_joint" type="continuous"><parent link="base"/>'
+        '<child link="rw"/></joint><gazebo><plugin name="d" '
+        'filename="libgazebo_ros_diff_drive.so"><robotBaseFrame>base</robotBaseFrame>'
+        f"<wheelDiameter>0.2</wheelDiameter>{extra}</plugin></gazebo></robot>"
+    )
+
+
+@pytest.mark.parametrize(
+    ("extra", "mass", "limit"),
+    [
+        ("<wheelTorque>1</wheelTorque>", 10.0, 2.0),  # 2 T / (r m) = 2 / (0.1 * 10)
+        ("<wheelTorque>1</wheelTorque><wheelAcceleration>1</wheelAcceleration>", 10.0, 1.0),
+        ("<wheelTorque>1</wheelTorque><wheelAcceleration>5</wheelAcceleration>", 10.0, 2.0),
+        ("", 10.0, 10.0),  # Gazebo's default wheelTorque, 5 N m: 2 * 5 / (0.1 * 10)
+        ("<wheelTorque>1</wheelTorque>", None, 0.0),  # no mass: no torque limit (unlimited)
+    ],
+)
+def test_wheel_torque_limits_the_acceleration(extra: str, mass: float | None, limit: float) -> None:
+    from roverlab.sim.robot import sim_config_from_model
+
+    config = sim_config_from_model(load_robot(_drive(extra, mass)))
+    assert config.drive is not None
+    assert config.drive.params.wheel_acceleration == pytest.approx(limit)
+
+
+def test_diff_drive_settings_the_simulator_does_not_act_on_are_warned() -> None:
+    from roverlab.description.check import robot_warnings
+
+    flags = (
+        "<publishWheelTF>true</publishWheelTF><publishWheelJointState>true</publishWheelJointState>"
+    )
+    warnings = robot_warnings(load_robot(_drive(flags, 1.0)))
+    assert any("publishWheelTF is not simulated" in w for w in warnings), warnings
+    assert any("legacyMode true swaps the wheels' speeds" in w for w in warnings), warnings
+    quiet = robot_warnings(load_robot(_drive("<legacyMode>false</legacyMode>", 1.0)))
+    assert not [w for w in quiet if "diff_drive" in w], quiet

@@ -47,12 +47,34 @@ def robot_warnings(model: RobotModel) -> list[str]:
     if sensors:
         out.append(f"{src}: Gazebo sensor types not simulated (ignored): {', '.join(sensors)}")
     out += _shape_warnings(model)
+    out += _drive_warnings(model)
     unknown = [r for r in model.gazebo.references if r not in model.links and r not in model.joints]
     if unknown:
         out.append(
             f"{src}: <gazebo reference> names no link or joint (ignored): "
             + ", ".join(f"'{r}'" for r in unknown)
         )
+    return out
+
+
+def _drive_warnings(model: RobotModel) -> list[str]:
+    """gazebo_ros_diff_drive settings the simulator's kinematic drive does not act on."""
+    out: list[str] = []
+    for plugin in model.gazebo.plugins:
+        spec = plugin.spec
+        if not isinstance(spec, DiffDriveSpec):
+            continue
+        where = f"{model.source}: <plugin {plugin.filename}>"
+        if spec.publish_wheel_tf:
+            out.append(
+                f"{where}: publishWheelTF is not simulated; with publishWheelJointState, "
+                "robot_state_publisher gives the wheels' transforms"
+            )
+        if spec.legacy_mode and spec.publish_wheel_joint_state:
+            out.append(
+                f"{where}: legacyMode true swaps the wheels' speeds in Gazebo (an old bug "
+                "kept for old URDFs); the simulated joint states report each wheel's own"
+            )
     return out
 
 

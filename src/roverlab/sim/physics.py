@@ -26,9 +26,11 @@ class DiffDriveParams:
     Args:
         wheel_separation_m: distance between the wheels' contact points.
         wheel_diameter_m: wheel diameter.
-        wheel_acceleration: max change of wheel surface speed, m/s^2 (0 = unlimited).
-        max_wheel_speed_mps: clamp of each wheel's surface speed (from ``wheelTorque`` we
-            cannot derive one; this guards against absurd commands).
+        wheel_acceleration: max change of wheel surface speed, m/s^2 (0 = unlimited): the
+            plugin's ``wheelAcceleration``, or less when ``wheelTorque`` cannot push the
+            robot's mass faster (see ``sim.robot``).
+        max_wheel_speed_mps: clamp of each wheel's surface speed (a guard against absurd
+            commands; the plugin has no speed limit).
         slip_stddev: relative 1-sigma slip of each wheel per physics step (0 = no slip;
             the simulator node's ``wheel_slip`` parameter sets it).
     """

@@ -83,6 +83,17 @@ def _body_points(model: RobotModel, base: str) -> F64:
     return np.vstack(pts) if pts else np.zeros((0, 3))
 
 
+def _wheel_acceleration(model: RobotModel, dd: DiffDriveSpec) -> float:
+    """The wheels' surface acceleration limit: ``wheelAcceleration``, and what
+    ``wheelTorque`` can give the robot's mass (two wheels pushing: 2 T / (r m)); 0 means
+    unlimited, as the plugin's ``wheelAcceleration`` 0."""
+    mass = sum(link.inertial.mass for link in model.links.values() if link.inertial is not None)
+    limits = [dd.wheel_acceleration] if dd.wheel_acceleration > 0 else []
+    if mass > 0 and dd.wheel_torque_nm > 0:
+        limits.append(2.0 * dd.wheel_torque_nm / (0.5 * dd.wheel_diameter_m * mass))
+    return min(limits) if limits else 0.0
+
+
 def _footprint(points: F64) -> F64:
     xy = points[:, :2]
     if len(xy) < 3:
@@ -137,7 +148,7 @@ def sim_config_from_model(model: RobotModel) -> RobotSimConfig:
             params=DiffDriveParams(
                 wheel_separation_m=dd.wheel_separation_m,
                 wheel_diameter_m=dd.wheel_diameter_m,
-                wheel_acceleration=dd.wheel_acceleration,
+                wheel_acceleration=_wheel_acceleration(model, dd),
             ),
             command_topic=dd.command_topic,
             odometry_topic=dd.odometry_topic,
