@@ -7,14 +7,52 @@ import threading
 import time
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import Annotated, Any
 
 import typer
 
 from roverlab.batch import Episode, EpisodeFn, run_batch, write_batch_outputs
 from roverlab.cli.common import stop_on_signals
 
-__all__ = ["absolute", "run_episodes"]
+__all__ = [
+    "EpisodesOption",
+    "RayAddressOption",
+    "WorkersOption",
+    "absolute",
+    "is_batch",
+    "run_episodes",
+]
+
+# the options every batch-capable command takes (roverlab explore, roverlab nav bench)
+EpisodesOption = Annotated[
+    int,
+    typer.Option(
+        "--episodes",
+        help="Run this many episodes; episode i uses seed SEED+i. More than one writes "
+        "OUT/episodes.json, episodes.csv, episodes.png and OUT/episode_NNN/.",
+    ),
+]
+WorkersOption = Annotated[
+    int,
+    typer.Option(
+        "--workers",
+        help="Episodes run in parallel on this many CPUs (a local Ray instance; "
+        "needs the 'ray' extra). 1: one after the other, no Ray.",
+    ),
+]
+RayAddressOption = Annotated[
+    str | None,
+    typer.Option(
+        "--ray-address",
+        help="Run the episodes on this running Ray cluster (e.g. ray://head:10001 or "
+        "auto); see docs/scale.md.",
+    ),
+]
+
+
+def is_batch(episodes: int, workers: int, address: str | None) -> bool:
+    """Whether the batch options ask for more than the command's single run."""
+    return episodes != 1 or workers != 1 or address is not None
 
 
 def absolute(name_or_path: str) -> str:

@@ -12,7 +12,14 @@ import typer
 from roverlab.autonomy.explore_batch import PLOT_COLUMNS, explore_episode
 from roverlab.autonomy.explore_run import run_explore, write_explore_outputs
 from roverlab.autonomy.stack import SLAM_METHODS, AutonomyError
-from roverlab.cli.batch import absolute, run_episodes
+from roverlab.cli.batch import (
+    EpisodesOption,
+    RayAddressOption,
+    WorkersOption,
+    absolute,
+    is_batch,
+    run_episodes,
+)
 from roverlab.cli.common import stop_on_signals
 from roverlab.cli.sim import parse_rate
 from roverlab.core import configure_logging
@@ -47,30 +54,9 @@ def explore(
     x: Annotated[float, typer.Option("-x", help="Spawn x (m).")] = 0.0,
     y: Annotated[float, typer.Option("-y", help="Spawn y (m).")] = 0.0,
     yaw: Annotated[float, typer.Option("-Y", "--yaw", help="Spawn yaw (rad).")] = 0.0,
-    episodes: Annotated[
-        int,
-        typer.Option(
-            "--episodes",
-            help="Run this many episodes; episode i uses seed SEED+i. More than one writes "
-            "OUT/episodes.json, episodes.csv, episodes.png and OUT/episode_NNN/.",
-        ),
-    ] = 1,
-    workers: Annotated[
-        int,
-        typer.Option(
-            "--workers",
-            help="Episodes run in parallel on this many CPUs (a local Ray instance; "
-            "needs the 'ray' extra). 1: one after the other, no Ray.",
-        ),
-    ] = 1,
-    ray_address: Annotated[
-        str | None,
-        typer.Option(
-            "--ray-address",
-            help="Run the episodes on this running Ray cluster (e.g. ray://head:10001 or "
-            "auto); see docs/scale.md.",
-        ),
-    ] = None,
+    episodes: EpisodesOption = 1,
+    workers: WorkersOption = 1,
+    ray_address: RayAddressOption = None,
 ) -> None:
     """Explore a world with explore_lite + move_base + a SLAM node, then score the map.
 
@@ -87,7 +73,7 @@ def explore(
         raise AutonomyError(f"--out {out}: not a folder")
     pace = parse_rate(rate)
     configure_logging()
-    if episodes != 1 or workers != 1 or ray_address is not None:
+    if is_batch(episodes, workers, ray_address):
         if not math.isinf(pace):
             raise AutonomyError("--episodes/--workers run at --rate max only")
         config = {

@@ -10,7 +10,14 @@ from typing import Annotated
 
 import typer
 
-from roverlab.cli.batch import absolute, run_episodes
+from roverlab.cli.batch import (
+    EpisodesOption,
+    RayAddressOption,
+    WorkersOption,
+    absolute,
+    is_batch,
+    run_episodes,
+)
 from roverlab.navbench import LOCALIZATIONS, PLANNERS, BenchConfig, run_bench
 from roverlab.navbench.batch import PLOT_COLUMNS, nav_episode
 
@@ -56,35 +63,14 @@ def bench(
         typer.Option("--params", help="Folder of robot_navigation parameter files."),
     ] = None,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No per-goal lines.")] = False,
-    episodes: Annotated[
-        int,
-        typer.Option(
-            "--episodes",
-            help="Run this many episodes; episode i uses seed SEED+i. More than one writes "
-            "OUT/episodes.json, episodes.csv, episodes.png and OUT/episode_NNN/.",
-        ),
-    ] = 1,
-    workers: Annotated[
-        int,
-        typer.Option(
-            "--workers",
-            help="Episodes run in parallel on this many CPUs (a local Ray instance; "
-            "needs the 'ray' extra). 1: one after the other, no Ray.",
-        ),
-    ] = 1,
-    ray_address: Annotated[
-        str | None,
-        typer.Option(
-            "--ray-address",
-            help="Run the episodes on this running Ray cluster (e.g. ray://head:10001 or "
-            "auto); see docs/scale.md.",
-        ),
-    ] = None,
+    episodes: EpisodesOption = 1,
+    workers: WorkersOption = 1,
+    ray_address: RayAddressOption = None,
 ) -> None:
     """Run simulator + map_server + amcl + move_base on seeded random goals, as fast as
     the CPU allows; print one summary line (per-goal lines go to stderr)."""
     logging.getLogger("roverlab").setLevel(logging.ERROR)
-    if episodes != 1 or workers != 1 or ray_address is not None:
+    if is_batch(episodes, workers, ray_address):
         BenchConfig(
             world=world,
             out=out,
