@@ -125,7 +125,13 @@ def test_sim_record_finishes_the_file_on_a_signal(
     p = Proc([*RL, "sim", "--no-expose", "--record", str(out), "--world", "empty"])
     try:
         _wait_stderr(p, "simulating", timeout=60)
-        time.sleep(1.5)
+        # the first scans come after the ray caster is compiled (seconds on a clean
+        # checkout's empty numba cache): wait until flushed chunks hold some data
+        part = tmp_path / "sim.mcap.part"
+        deadline = time.monotonic() + 90
+        while not (part.is_file() and part.stat().st_size > 50_000):
+            assert time.monotonic() < deadline and p.popen.poll() is None, p.stderr()
+            time.sleep(0.2)
         p.popen.send_signal(sig)
         assert p.popen.wait(timeout=30) == 0, p.stderr()
     finally:
