@@ -15,7 +15,6 @@ from roverlab.navigation.costmap import (
     pad_footprint,
     transform_footprint,
 )
-from roverlab.navigation.costmap.kernels import footprint_cost, line_cost
 from roverlab.navigation.errors import CostmapError, NavigationParamsError
 
 
@@ -78,32 +77,3 @@ def test_footprints_from_radius_string_and_padding() -> None:
         footprint_from_param("[[0.1, 0.1], [")
     placed = transform_footprint(1.0, 2.0, math.pi / 2, square)
     assert placed[0] == pytest.approx([0.9, 2.1])
-
-
-def test_footprint_cost_sees_every_cell_the_outline_crosses() -> None:
-    """Where DWA wedged mybot in a held-out door (narrow_doors, seed 0): the footprint's
-    slanted left edge crosses a corner of a door post's lethal cell. A Bresenham line
-    between the vertices' cells (CostmapModel's) passes beside that cell, so the pose looked
-    legal and the robot drove there; 1 cm further back the line caught it, and every motion
-    was refused. The exact outline refuses the pose itself and accepts it once clear."""
-    res, ox, oy = 0.05, 9.0, 0.5
-    costs = np.zeros((60, 60), dtype=np.uint8)
-    lethal = (int((10.42 - ox) / res), int((1.92 - oy) / res))  # cell [10.40, 10.45) x [1.90, 1.95)
-    costs[lethal[1], lethal[0]] = 254
-    fp = np.array([[-0.135, -0.11], [-0.135, 0.11], [0.135, 0.11], [0.135, -0.11]])
-    buf = np.empty((256, 2), dtype=np.int64)
-    x, y, th = 10.5415, 1.8735, 1.3280
-
-    def bresenham_outline(px: float, py: float) -> float:
-        c, s = math.cos(th), math.sin(th)
-        cells = [
-            (int((px + a * c - b * s - ox) / res), int((py + a * s + b * c - oy) / res))
-            for a, b in fp
-        ]
-        return min(line_cost(costs, *cells[k], *cells[(k + 1) % 4], buf) for k in range(4))
-
-    assert bresenham_outline(x, y) >= 0  # CostmapModel: legal
-    assert bresenham_outline(x - 0.01 * math.cos(th), y - 0.01 * math.sin(th)) < 0
-    assert footprint_cost(costs, res, ox, oy, x, y, th, fp, 1.0, buf) == -6.0
-    # 5 cm further from the post (to the right, across the edge) the outline is clear
-    assert footprint_cost(costs, res, ox, oy, x + 0.05, y, th, fp, 1.0, buf) == 0.0

@@ -289,19 +289,10 @@ def footprint_cost(
     scale: float,
     buf: NDArray[np.int64],
 ) -> float:
-    """base_local_planner's ``footprintCost`` at ``(x, y, th)`` (CostmapModel's check of
-    the outline of the footprint ``fp`` scaled by ``scale``): the highest cost on its
+    """base_local_planner's ``footprintCost`` at ``(x, y, th)`` (CostmapModel's edge
+    rasterisation of the footprint ``fp`` scaled by ``scale``): the highest cost on its
     outline (and its centre cell), or -6 when a cell is lethal or unknown or the footprint
-    leaves the grid. ``buf`` is scratch space for the outline's cells (at least
-    ``size_x + size_y + 2`` of them in all).
-
-    The outline is every cell its edges cross (roverlab's exact grid tracer, from the
-    vertices' true positions), where CostmapModel draws a Bresenham line between the
-    vertices' cells: one cell per step along the major axis, so a slanted edge can pass a
-    corner of a lethal cell unseen, and the same edge a centimetre further can catch it.
-    A robot driven by such a check ends up over a lethal cell its checks missed, where
-    every motion's check catches it (DWA and rotate_recovery then refuse every command).
-    """
+    leaves the grid. ``buf`` is scratch space for the Bresenham cells."""
     h, w = costs.shape
     if x < ox or y < oy:
         return -6.0
@@ -318,25 +309,24 @@ def footprint_cost(
         return center
     c = math.cos(th)
     s = math.sin(th)
-    flat_costs = costs.reshape(-1)
-    cells = buf.reshape(-1)
     best = 0.0
-    gx0 = 0.0
-    gy0 = 0.0
+    px0 = 0
+    py0 = 0
     for k in range(m + 1):
         j = k % m
-        gx = (x + scale * (fp[j, 0] * c - fp[j, 1] * s) - ox) / res
-        gy = (y + scale * (fp[j, 0] * s + fp[j, 1] * c) - oy) / res
-        if gx < 0.0 or gy < 0.0 or gx >= w or gy >= h:
+        wx = x + scale * (fp[j, 0] * c - fp[j, 1] * s)
+        wy = y + scale * (fp[j, 0] * s + fp[j, 1] * c)
+        if wx < ox or wy < oy:
+            return -6.0
+        mx = int((wx - ox) / res)
+        my = int((wy - oy) / res)
+        if mx >= w or my >= h:
             return -6.0
         if k > 0:
-            n = trace_segment_cells(gx0, gy0, gx, gy, w, h, cells)
-            for q in range(n):
-                v = flat_costs[cells[q]]
-                if v in (LETHAL, NO_INFO):
-                    return -6.0
-                if v > best:
-                    best = float(v)
-        gx0 = gx
-        gy0 = gy
+            lc = line_cost(costs, px0, py0, mx, my, buf)
+            if lc < 0:
+                return -6.0
+            best = max(best, lc)
+        px0 = mx
+        py0 = my
     return max(best, center)

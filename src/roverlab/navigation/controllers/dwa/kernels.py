@@ -6,11 +6,10 @@ rejects the trajectory):
 
 1. oscillation (scale 1): a direction forbidden by the oscillation flags: -5 / -7 / -6;
 2. obstacle (``occdist_scale``): every point's footprint (scaled by the speed factor, see
-   :func:`score_rollouts`) laid on the costmap along its edges (every cell an edge
-   crosses: :func:`~roverlab.navigation.costmap.kernels.footprint_cost`); a lethal or
-   unknown cell or a vertex off the map: -6, the centre off the map: -7; the cost is the
-   highest cell cost (the sum with ``sum_scores``); the rollout is also checked for
-   ``stop_time_buffer`` seconds beyond its end;
+   :func:`score_rollouts`) laid on the costmap along its edges; a lethal or unknown cell
+   or a vertex off the map: -6, the centre off the map: -7; the cost is the highest cell
+   cost (the sum with ``sum_scores``); the rollout is also checked for ``stop_time_buffer``
+   seconds beyond its end;
 3. goal front (``goal_distance_bias``): the local-goal grid at the point
    ``forward_point_distance`` ahead of the last pose (no failure);
 4. alignment (``path_distance_bias``, 0 near the goal): the path grid at that point;
