@@ -17,6 +17,7 @@ from roverlab.geometry import SE2, Transform3
 from roverlab.launch import LaunchError, build_launch
 from roverlab.mapping.gmapping import GMappingParams
 from roverlab.mapping.gmapping.node import SlamGMapping
+from roverlab.mapping.graph.node import SlamToolbox
 from roverlab.mapping.hector import HectorParams
 from roverlab.mapping.hector.node import NODE_DEFAULTS, HectorMapping
 from roverlab.mapping.laser import laser_geometry
@@ -378,3 +379,51 @@ def test_bad_and_unknown_launch_params(tmp_path: Path) -> None:
     )
     launch = build_launch(odd, context=Context())
     assert len(launch.warnings) == 1 and "map_sise, pub_drawings" in launch.warnings[0]
+
+
+@pytest.mark.parametrize(
+    ("node_type", "expected"),
+    [("async_slam_toolbox_node", 1), ("sync_slam_toolbox_node", 6)],
+)
+def test_slam_toolbox_async_takes_the_newest_scan_sync_takes_all(
+    node_type: str, expected: int, caplog: pytest.LogCaptureFixture, tmp_path: Path
+) -> None:
+    """Six scans arrive while the mapper is busy: the asynchronous node processes only the
+    newest, the synchronous one all six in order (slam_toolbox's two modes)."""
+    ctx = Context()
+    robot = FakeRobot(ctx, SE2(-0.5, 0.2, 0.3), base="base_footprint")
+    robot.start_tf()
+    launch = tmp_path / "slam.launch"
+    launch.write_text(f'<launch><node pkg="slam_toolbox" type="{node_type}" name="st"/></launch>')
+    (node,) = build_launch(launch, context=ctx).nodes
+    assert isinstance(node, SlamToolbox) and node.synchronous == (expected > 1)
+    ctx.spin_for(0.55)
+    assert node.scans_processed >= 4
+    robot.destroy_timer(robot.timers[0])  # no more scans from the robot's own timer
+    stamps: list[float] = []
+    process = node.slam.process
+
+    def spy(*args: Any, **kwargs: Any) -> Any:
+        stamps.append(args[3])
+        return process(*args, **kwargs)
+
+    node.slam.process = spy  # type: ignore[method-assign]
+    now = robot.get_clock().now().nanoseconds / 1e9
+    burst = [round(now - 0.01 * k, 6) for k in range(6, 0, -1)]
+    angles = np.linspace(-math.pi, math.pi, 361)[:-1]
+    for t in burst:  # published back to back: the executor does not run in between
+        robot.scan_pub.publish(
+            make_scan(
+                np.full(angles.size, 2.0),
+                angle_min=-math.pi,
+                angle_max=math.pi - 2 * math.pi / 360,
+                range_min=0.1,
+                range_max=10.0,
+                frame_id="laser",
+                stamp=Time.from_seconds(t),
+            )
+        )
+    with caplog.at_level(logging.WARNING, logger="roverlab"):
+        ctx.spin_for(0.05)
+    assert len(stamps) == expected
+    assert stamps == pytest.approx(burst[-expected:], abs=1e-6)

@@ -1,8 +1,8 @@
 """The ``slam_toolbox`` / ``slam_karto`` node: a thin wrapper of
 :class:`~roverlab.mapping.graph.GraphSLAM`.
 
-What slam_toolbox's ``async_slam_toolbox_node`` (and ROS 1's ``slam_karto``) do, with their
-names:
+What slam_toolbox's ``async_slam_toolbox_node`` / ``sync_slam_toolbox_node`` (and ROS 1's
+``slam_karto``) do, with their names:
 
 * subscribes ``scan_topic`` (default ``/scan``, ``sensor_msgs/LaserScan``) through a TF
   message filter: a scan is processed once ``odom_frame <- scan frame`` is known at its
@@ -15,6 +15,14 @@ names:
   poses;
 * broadcasts ``map_frame -> odom_frame`` every ``transform_publish_period`` seconds (0:
   never), the identity until the first scan.
+
+The two slam_toolbox modes differ in what happens to scans that arrive while one is being
+processed (a slow machine, or a bag played fast): the asynchronous node (:class:`SlamToolbox`)
+keeps only the newest one and skips the rest, so the map keeps up with the robot; the
+synchronous node (:class:`SyncSlamToolbox`, and ``slam_karto``) queues every scan and
+processes them all in order, warning when the queue grows (offline-quality maps, at the
+price of lagging behind). In a ``--rate max`` run simulated time waits for the nodes, so both
+see every scan.
 
 Parameters: every field of :class:`~roverlab.mapping.graph.GraphParams` under its ROS name
 and default, plus the node's ``scan_topic``, ``scan_queue_size`` and
@@ -46,7 +54,7 @@ from roverlab.tf import (
     transform_to_msg,
 )
 
-__all__ = ["NODE_DEFAULTS", "SlamKarto", "SlamToolbox"]
+__all__ = ["NODE_DEFAULTS", "SlamKarto", "SlamToolbox", "SyncSlamToolbox"]
 
 _LATCHED = QoSProfile(depth=1, durability="transient_local")
 
@@ -56,6 +64,12 @@ NODE_DEFAULTS: dict[str, Any] = {
     "scan_queue_size": 5,
     "transform_publish_period": 0.02,
 }
+
+#: A synchronous node's bound on scans waiting to be processed (slam_toolbox's queue is
+#: unbounded; this is a memory guard: about 20 minutes of a 10 Hz laser).
+SYNC_QUEUE_LIMIT = 12_000
+#: The synchronous node warns when more scans than this wait.
+SYNC_QUEUE_WARN = 10
 
 
 class SlamToolbox(Node):
@@ -80,6 +94,9 @@ class SlamToolbox(Node):
 
     #: Default of ``base_frame`` for this node (slam_toolbox's).
     default_base_frame = "base_footprint"
+    #: False: only the newest waiting scan is processed (slam_toolbox's asynchronous mode);
+    #: True: every scan is, in order (its synchronous mode).
+    synchronous = False
 
     def __init__(
         self, context: Context, *, node_name: str = "slam_toolbox", **node_kwargs: Any
@@ -113,13 +130,27 @@ class SlamToolbox(Node):
         self.scan_filter = TfMessageFilter(
             self, self.tf_buffer, [self.odom_frame], queue, self._on_scan
         )
-        self.create_subscription(mc.LaserScan, str(node["scan_topic"]), self.scan_filter.add, queue)
+        depth = SYNC_QUEUE_LIMIT if self.synchronous else 1
+        self.scan_subscription = self.create_subscription(
+            mc.LaserScan, str(node["scan_topic"]), self._on_scan_message, depth
+        )
         self.create_timer(p.map_update_interval, self.publish_map)
         period = float(node["transform_publish_period"])
         if period > 0.0:
             self.create_timer(period, self._publish_transform)
 
     # ------------------------------------------------------------------ scans
+    def _on_scan_message(self, scan: Any) -> None:
+        if self.synchronous:
+            waiting = self.scan_subscription.pending
+            if waiting > SYNC_QUEUE_WARN:
+                self._throttle.warning(
+                    "queue",
+                    f"{waiting} scans wait to be processed: the map lags behind the robot "
+                    "(the asynchronous node skips to the newest scan instead)",
+                )
+        self.scan_filter.add(scan)
+
     def _on_scan(self, scan: Any) -> None:
         try:
             stamp, laser, odom = scan_inputs(self.tf_buffer, scan, self.base_frame, self.odom_frame)
@@ -178,10 +209,18 @@ class SlamToolbox(Node):
         )
 
 
+class SyncSlamToolbox(SlamToolbox):
+    """``sync_slam_toolbox_node``: the same mapper, processing every scan in order."""
+
+    synchronous = True
+
+
 class SlamKarto(SlamToolbox):
-    """ROS 1 ``slam_karto``: the same mapper under slam_karto's node name and base frame."""
+    """ROS 1 ``slam_karto``: the same mapper under slam_karto's node name and base frame;
+    like Karto's node it processes every scan (synchronous)."""
 
     default_base_frame = "base_link"
+    synchronous = True
 
     def __init__(self, context: Context, *, node_name: str = "slam_karto", **node_kwargs: Any):
         super().__init__(context, node_name=node_name, **node_kwargs)
