@@ -13,13 +13,13 @@ and :func:`chi2` is ``sum_k e_k^T Omega_k e_k`` (no 1/2), as g2o prints it.
 under a watchdog (a step may raise chi2 for a while, as after a big loop closure, but the
 best poses are kept) and Levenberg-Marquardt with Nielsen's damping update when Gauss-Newton
 stops making progress. Jacobians are analytic, computed for all edges at once with numpy
-and assembled into a ``scipy.sparse`` matrix, factorised by SuperLU in a fill-reducing
-order computed once per run. The gauge is fixed by holding the first vertex (or the
-vertices of the file's ``FIX`` lines) at its initial value. From a poor start on a big
-loopy graph any local method can stop in a local minimum: :func:`chordal_initialisation`
-gives a start near the global optimum by solving first for the orientations (a linear
-least-squares problem on ``(cos, sin)`` pairs, normalised afterwards) and then, with the
-orientations fixed, for the positions (linear again).
+and assembled into a ``scipy.sparse`` matrix, factorised by QDLDL (sparse LDL^T) in an
+approximate-minimum-degree order analysed once per run. The gauge is fixed by holding the
+first vertex (or the vertices of the file's ``FIX`` lines) at its initial value. From a
+poor start on a big loopy graph any local method can stop in a local minimum:
+:func:`chordal_initialisation` gives a start near the global optimum by solving first for
+the orientations (a linear least-squares problem on ``(cos, sin)`` pairs, normalised
+afterwards) and then, with the orientations fixed, for the positions (linear again).
 
 Reached on the benchmark graphs of ``shared/data/posegraphs`` from the files' own starts
 (reference in brackets): INTEL 215.830 (215.83), M3500 137.913 (137.91), CSAIL 40.555
@@ -41,10 +41,10 @@ from pathlib import Path
 from typing import Any, Final, Literal
 
 import numpy as np
+import qdldl
 import scipy.sparse as sp
 from numpy.typing import ArrayLike, NDArray
 from scipy.sparse.csgraph import connected_components
-from scipy.sparse.linalg import splu
 
 from roverlab.slam._io import atomic_write_text
 from roverlab.slam.errors import PoseGraphError
@@ -476,40 +476,38 @@ def _assemble(
 
 
 class _Factoriser:
-    """Sparse LU of symmetric positive definite systems with a fixed sparsity pattern.
+    """Sparse LDL^T factorisations of symmetric positive definite systems that keep their
+    sparsity pattern from one solve to the next (QDLDL, in an approximate-minimum-degree
+    order).
 
-    The fill-reducing ordering (minimum degree on the vertex graph, each vertex's ``d``
-    unknowns kept together) is computed once; every :meth:`solve` then factorises with
-    SuperLU in that order, without pivoting.
+    The ordering and the symbolic analysis are done on the first :meth:`solve`; later
+    solves with the same pattern only refactorise numerically (a new pattern starts over).
     """
 
-    def __init__(self, col: IndexArray, n: int, d: int, fr: IndexArray, to: IndexArray) -> None:
-        ci, cj = col[fr], col[to]
-        ok = (ci >= 0) & (cj >= 0)
-        diag = np.arange(n)
-        pattern = sp.csc_matrix(
-            (
-                np.r_[np.ones(2 * int(ok.sum())), np.full(n, 4.0 * (n + 1))],
-                (np.r_[ci[ok], cj[ok], diag], np.r_[cj[ok], ci[ok], diag]),
-            ),
-            shape=(n, n),
-        )
-        lu = splu(
-            pattern,
-            permc_spec="MMD_AT_PLUS_A",
-            diag_pivot_thresh=0.0,
-            options={"SymmetricMode": True},
-        )
-        order = np.argsort(lu.perm_c)
-        self._perm = (d * order[:, None] + np.arange(d)).ravel()
+    def __init__(self) -> None:
+        self._solver: Any = None
+        self._indptr = np.zeros(0, dtype=np.int64)
+        self._indices = np.zeros(0, dtype=np.int64)
 
     def solve(self, h: sp.spmatrix, rhs: FloatArray) -> FloatArray:
         """``h^-1 rhs``; raises RuntimeError when ``h`` is singular."""
-        p = self._perm
-        hp = sp.csc_matrix(h)[p][:, p].tocsc()
-        lu = splu(hp, permc_spec="NATURAL", diag_pivot_thresh=0.0, options={"SymmetricMode": True})
-        out = np.empty_like(rhs)
-        out[p] = lu.solve(rhs[p])
+        upper = sp.triu(h, format="csc")
+        upper.sort_indices()
+        same = (
+            self._solver is not None
+            and np.array_equal(upper.indptr, self._indptr)
+            and np.array_equal(upper.indices, self._indices)
+        )
+        try:
+            if same:
+                self._solver.update(upper, upper=True)
+            else:
+                self._solver = qdldl.Solver(upper, upper=True)
+                self._indptr, self._indices = upper.indptr.copy(), upper.indices.copy()
+            out = np.asarray(self._solver.solve(rhs), dtype=np.float64)
+        except ValueError as err:  # QDLDL: a zero pivot
+            self._solver = None
+            raise RuntimeError(f"the factorisation failed: {err}") from err
         if not np.all(np.isfinite(out)):
             raise RuntimeError("the factorisation is numerically singular")
         return out
@@ -550,7 +548,7 @@ def chordal_initialisation(graph: PoseGraph, poses: ArrayLike | None = None) -> 
     free_rows = np.flatnonzero(col >= 0)
     known = (col < 0)[:, None]
     eye = np.broadcast_to(np.eye(2), (count, 2, 2))
-    factoriser = _Factoriser(col, n, 2, fr, to)
+    factoriser = _Factoriser()
     # 1. orientations: residual r_j - M(z) r_i with M(z) = [[c, -s], [s, c]]
     cz, sz = np.cos(z[:, 2]), np.sin(z[:, 2])
     m = np.empty((count, 2, 2))
@@ -663,8 +661,8 @@ def optimize(
 
     Every iteration linearises all edges at once (analytic Jacobians, vectorised over
     edges), assembles the sparse normal equations ``(H + lambda D) dx = -g`` over the free
-    vertices, ``D = diag(H)``, and solves them by a sparse LU factorisation in a
-    fill-reducing order computed once. Poses are updated additively (angles wrapped), as
+    vertices, ``D = diag(H)``, and solves them by a sparse LDL^T factorisation in a
+    fill-reducing order analysed once. Poses are updated additively (angles wrapped), as
     g2o's ``VertexSE2`` does.
 
     ``method="auto"`` starts with undamped Gauss-Newton steps (``lambda = 0``) under a
@@ -729,7 +727,7 @@ def optimize(
         return x, report("nothing to optimise", True, 0, 0)
     _check_connected(graph)
     free_rows = np.flatnonzero(col >= 0)
-    factoriser = _Factoriser(col, n, 3, graph.edge_from, graph.edge_to)
+    factoriser = _Factoriser()
     gauss_newton = method == "auto"
     best_x, best_f = x, f  # Gauss-Newton phase: the best poses so far
     misses = 0
