@@ -9,6 +9,7 @@ import pytest
 
 from roverlab.raycast import Scene
 from roverlab.sim.collision import Obstacles, circle_polygon, inner_radius, polygon_hits
+from roverlab.sim.diff_drive import DiffDriveParams
 from roverlab.sim.dynamics import (
     S_AL,
     S_CONTACT,
@@ -25,7 +26,6 @@ from roverlab.sim.dynamics import (
     STATE_SIZE,
     advance,
 )
-from roverlab.sim.physics import DiffDriveParams
 
 SEP, DIAM = 0.18, 0.05
 NO_WALLS = np.zeros((0, 4))
