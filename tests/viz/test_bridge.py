@@ -4,6 +4,7 @@ statuses, Save map, compressed images, drive speeds."""
 from __future__ import annotations
 
 import io
+import json
 import struct
 from pathlib import Path
 
@@ -20,7 +21,7 @@ from roverlab.tf.convert import transform_to_msg
 from roverlab.viz.bridge import VizBridge
 from roverlab.viz.config import DashboardConfig, DisplayConfig
 from roverlab.viz.errors import DashboardError
-from roverlab.viz.protocol import KIND_MAP, KIND_MAP_PATCH, KIND_POSES
+from roverlab.viz.protocol import KIND_MAP, KIND_MAP_PATCH, KIND_POSES, POSES_3D
 
 LATCHED = QoSProfile(depth=1, durability="transient_local")
 
@@ -102,8 +103,9 @@ def test_statuses_no_publisher_no_messages_tf_failure_and_ok() -> None:
     assert _rows(bridge, 0)["Topic"][0] == "ok" and _rows(bridge, 0)["Transform"][0] == "ok"
     frame = bridge.displays[0].frame
     assert frame is not None and frame.payload[0] == KIND_POSES
-    xyyaw = np.frombuffer(frame.payload[8:], dtype="<f4")
-    assert np.allclose(xyyaw, [2.0, 2.0, 0.0])  # odom is 1 m along map's x
+    assert frame.payload[1] == POSES_3D
+    pose = np.frombuffer(frame.payload[8:], dtype="<f4")
+    assert np.allclose(pose, [2.0, 2.0, 0.0, 0.0, 0.0, 0.0, 1.0])  # odom is 1 m along map's x
     level, text = _rows(bridge, 1)["Transform"]
     assert level == "error" and "ghost" in text
     assert _rows(bridge, 2)["Topic"] == ("warn", "No messages received on /quiet")
@@ -206,7 +208,9 @@ def test_marker_lifetime_expires_on_the_executor_clock() -> None:
     ctx.spin_for(0.5)
     frame = bridge.displays[0].frame
     assert frame is not None and '"polygon"' in frame.payload
+    solid = json.loads(frame.payload)["items3d"][0]
+    assert solid["type"] == 1 and solid["pose"] == [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0]
     ctx.spin_for(1.0)
     frame = bridge.displays[0].frame
-    assert frame is not None and frame.payload == "[]"
+    assert frame is not None and json.loads(frame.payload) == {"items": [], "items3d": []}
     ctx.shutdown()

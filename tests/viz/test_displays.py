@@ -134,12 +134,14 @@ def test_map_change_window() -> None:
 
 
 def test_colour_buckets_and_decimation() -> None:
-    idx, pal = color_buckets("FlatColor", count=5, flat_rgb=[1, 2, 3], alpha=0.5)
-    assert idx is None and pal.tolist() == [[1, 2, 3, 128]]
+    idx, pal, bounds = color_buckets("FlatColor", count=5, flat_rgb=[1, 2, 3], alpha=0.5)
+    assert idx is None and pal.tolist() == [[1, 2, 3, 128]] and bounds is None
     z = np.array([0.0, 0.5, 1.0, np.nan])
-    idx, pal = color_buckets("AxisColor", count=4, flat_rgb=[0, 0, 0], alpha=1.0, values=z)
-    assert idx is not None and idx.tolist() == [0, 16, 31, 0] and len(pal) == 32
-    assert pal[0, :3].tolist() == [255, 0, 255] and pal[-1, :3].tolist() == [255, 0, 0]
+    idx, pal, bounds = color_buckets("AxisColor", count=4, flat_rgb=[0, 0, 0], alpha=1.0, values=z)
+    assert idx is not None and idx.tolist() == [0, 32, 63, 0] and len(pal) == 64
+    assert bounds == (0.0, 1.0)
+    # rviz's AxisColor: the lowest point red, the highest magenta
+    assert pal[0, :3].tolist() == [255, 0, 0] and pal[-1, :3].tolist() == [255, 0, 255]
     pts = np.arange(100_000).reshape(-1, 2)
     assert len(decimate(pts, 20_000)) <= 20_000 and len(decimate(pts, 0)) == 50_000
 

@@ -4,6 +4,7 @@
 import * as THREE from "three";
 import { STLLoader } from "./vendor/three/addons/loaders/STLLoader.js";
 import { ColladaLoader } from "./vendor/three/addons/loaders/ColladaLoader.js";
+import { buildMarker, markerShapeKey, setLineResolution } from "./markers3d.js";
 
 const viz = window.viz;
 const data = viz.data;
@@ -348,7 +349,11 @@ function updatePoses(slot, d, L) {
     for (let i = 0; i < p.length; i += 3) g.add(arrowMesh(o.length, col(o.color), o.alpha));
     return g;
   });
-  e.obj.children.forEach((a, j) => { a.position.set(p[3 * j], p[3 * j + 1], 0.02); a.rotation.set(0, 0, p[3 * j + 2]); });
+  const q = L.poses3;  // full poses: the arrow at its height, fully oriented
+  e.obj.children.forEach((a, j) => {
+    if (q) { a.position.set(q[7 * j], q[7 * j + 1], q[7 * j + 2]); a.quaternion.set(q[7 * j + 3], q[7 * j + 4], q[7 * j + 5], q[7 * j + 6]); }
+    else { a.position.set(p[3 * j], p[3 * j + 1], 0.02); a.rotation.set(0, 0, p[3 * j + 2]); }
+  });
 }
 function updatePath(slot, d, L) {
   const p = L.path;
@@ -357,8 +362,10 @@ function updatePath(slot, d, L) {
     new THREE.LineBasicMaterial({ color: col(d.options.color), transparent: true, opacity: d.options.alpha })));
   if (e.path === p) return;
   e.path = p;
-  const pts = new Float32Array(p.length / 2 * 3);
-  for (let i = 0, k = 0; i < p.length; i += 2, k += 3) { pts[k] = p[i]; pts[k + 1] = p[i + 1]; pts[k + 2] = 0.03; }
+  const q = L.path3, pts = new Float32Array(p.length / 2 * 3);
+  for (let i = 0, k = 0; i < p.length; i += 2, k += 3) {
+    pts[k] = p[i]; pts[k + 1] = p[i + 1]; pts[k + 2] = q ? q[k + 2] : 0.03;
+  }
   e.obj.geometry.setAttribute("position", new THREE.BufferAttribute(pts, 3));
   e.obj.geometry.computeBoundingSphere();
 }
@@ -367,6 +374,25 @@ function updateMarkers(slot, L) {
   const e = slotObject(slot, "markers", () => new THREE.Group());
   if (e.items === L.markers) return;
   e.items = L.markers;
+  if (L.markers3d) {  // Marker / MarkerArray: each (ns, id) in full 3D, rebuilt only when it changed
+    const old = e.byId || new Map(), next = new Map();
+    for (const m of L.markers3d) {
+      const id = m.ns + "/" + m.id, shape = markerShapeKey(m);
+      let it = old.get(id);
+      if (it && it.shape !== shape) { e.obj.remove(it.obj); dispose(it.obj); it = null; }
+      if (!it) {
+        const obj = buildMarker(m);
+        if (!obj) continue;
+        it = { shape, obj }; e.obj.add(obj);
+      }
+      old.delete(id);
+      setPose(it.obj, m.pose);
+      next.set(id, it);
+    }
+    for (const it of old.values()) { e.obj.remove(it.obj); dispose(it.obj); }  // deleted / expired
+    e.byId = next;
+    return;
+  }
   for (const c of [...e.obj.children]) { e.obj.remove(c); dispose(c); }
   for (const m of L.markers) {
     const c = new THREE.Color(m.rgba[0], m.rgba[1], m.rgba[2]), a = m.rgba[3];
@@ -384,15 +410,12 @@ function updateMarkers(slot, L) {
       e.obj.add(new THREE.Points(new THREE.BufferGeometry().setFromPoints(v3), new THREE.PointsMaterial({ color: c, size: Math.max(m.size, 0.02) })));
     } else if (m.shape === "arrow") {
       const ar = arrowMesh(m.length, c, a); ar.position.copy(v3[0]); ar.rotation.z = m.yaw; e.obj.add(ar);
-    } else if (m.shape === "text") {
-      tfText.push([m.text, v3[0]]);
     }
   }
 }
 
 // TF names as HTML labels, pushed apart so none overlap (rviz draws them over each other)
 let tfLabels = [];
-let tfText = [];
 const labelPool = [];
 function placeLabels(camera, w, h) {
   const items = [];
@@ -429,7 +452,7 @@ function placeLabels(camera, w, h) {
 
 function updateScene() {
   for (const o of objects.values()) o.seen = false;
-  tfLabels = []; tfText = [];
+  tfLabels = [];
   const cfg = data.config;
   if (cfg) {
     cfg.displays.forEach((d, slot) => {
@@ -544,6 +567,7 @@ function frame() {
     toolArrow.visible = true; toolArrow.position.set(drag.p.x, drag.p.y, 0.05); toolArrow.rotation.set(0, 0, drag.yaw);
     toolArrow.children.forEach((m) => m.material.color.setHex(c));
   } else toolArrow.visible = false;
+  setLineResolution(w, h);
   renderer.render(scene, camera);
   const t2 = performance.now();
   placeLabels(camera, w, h);
