@@ -110,6 +110,7 @@ function placeCamera(w, h) {
 
 // ----------------------------------------------------------------- displays
 const objects = new Map();  // slot -> { key, obj, ... }
+viz.objects3d = objects;  // for tests: what each display drew
 function slotObject(slot, key, make) {
   let o = objects.get(slot);
   if (o && o.key !== key) { scene.remove(o.obj); dispose(o.obj); o = null; }
