@@ -172,8 +172,8 @@ def _colour_near(img: np.ndarray, sx: float, sy: float, r: int = 4) -> np.ndarra
 
 def test_intensity_scan_markers_and_poses_in_3d(
     scene: tuple[DashboardServer, _Feed],
-    browser: Any,
-    tmp_path: Path,  # noqa: F811
+    browser: Any,  # noqa: F811
+    tmp_path: Path,
 ) -> None:
     server, feed = scene
     ready = (f"viz.data.layers[{SCAN}] && viz.data.layers[{SCAN}].points"
