@@ -15,7 +15,7 @@ from roverlab.core import Context, Node, QoSProfile
 from roverlab.geometry import SE2
 from roverlab.msgs import classes as mc
 from roverlab.sim.app import Simulation
-from roverlab.slam.mapquality import ReachableArea, grid_from_msg, ground_truth
+from roverlab.slam.data.mapquality import ReachableArea, grid_from_msg, ground_truth
 
 __all__ = ["CoverageSample", "RunMonitor"]
 

@@ -65,7 +65,7 @@ from roverlab.world.model import (
 
 __all__ = ["BUNDLED_MODELS_DIR", "load_sdf", "model_search_path"]
 
-BUNDLED_MODELS_DIR = Path(__file__).resolve().parent.parent / "worlds" / "models"
+BUNDLED_MODELS_DIR = Path(__file__).resolve().parent / "bundled" / "models"
 
 _IDENTITY = Transform3()
 
