@@ -168,6 +168,8 @@
       paintMap(m, m.scheme, x0, y0, w, h);
       m.version = (m.version || 0) + 1;
       m.dirty = m.dirty ? [Math.min(m.dirty[0], x0), Math.min(m.dirty[1], y0), Math.max(m.dirty[2], x0 + w), Math.max(m.dirty[3], y0 + h)] : [x0, y0, x0 + w, y0 + h];
+      const d3 = m.dirty3;  // the same for the 3D view's map levels (it clears its own)
+      m.dirty3 = d3 ? [Math.min(d3[0], x0), Math.min(d3[1], y0), Math.max(d3[2], x0 + w), Math.max(d3[3], y0 + h)] : [x0, y0, x0 + w, y0 + h];
     } else if (kind === KIND_POINTS) {
       // flags: 1 = (x, y, z) triples, 2 = one RGBA colour per point after the points
       const n = dv.getUint32(4, true), nb = dv.getUint32(8, true);

@@ -49,7 +49,13 @@ function setMode(mode) {
   canvas.style.display = is3d ? "block" : "none";
   labels.style.display = is3d ? "block" : "none";
   canvas2d.style.display = is3d ? "none" : "block";
-  const sel = document.getElementById("view-mode");
+  // benchmarks: n frames rendered back to back, each waited for (a one-pixel read), in ms per frame
+viz.renderSync = (n) => {
+  const gl = renderer.getContext(), px = new Uint8Array(4), t0 = performance.now();
+  for (let i = 0; i < n; i++) { renderer.render(scene, camera); gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, px); }
+  return (performance.now() - t0) / n;
+};
+const sel = document.getElementById("view-mode");
   if (sel && sel.value !== mode) sel.value = mode;
 }
 viz.setViewMode = setMode;
@@ -169,14 +175,45 @@ function paletteTexture(scheme) {
   tex.magFilter = tex.minFilter = THREE.NearestFilter; tex.needsUpdate = true;
   return tex;
 }
+// Far from the camera many cells fall on one pixel. The cells carry a chain of coarser levels
+// (mipmaps) built by "the most occupied wins" (signed max: unknown -1 < free 0 < occupied
+// 1..100), so a zoomed-out map keeps its walls instead of shimmering between cells, and the
+// renderer reads a few neighbouring texels per pixel instead of scattering over the whole
+// texture (with software WebGL the map plane was most of a frame's cost)
+function mapLevels(m) {
+  const levels = [{ data: new Uint8Array(m.cells.buffer, m.cells.byteOffset, m.w * m.h), width: m.w, height: m.h }];
+  for (let w = m.w, h = m.h; w > 1 || h > 1;) {
+    w = Math.max(1, w >> 1); h = Math.max(1, h >> 1);
+    levels.push({ data: new Uint8Array(w * h), width: w, height: h });
+  }
+  reduceLevels(levels, 0, 0, m.w, m.h);
+  return levels;
+}
+function reduceLevels(levels, x0, y0, x1, y1) {  // recompute the coarse levels over a window of level 0
+  for (let k = 1; k < levels.length; k++) {
+    const a = levels[k - 1], b = levels[k];
+    const src = new Int8Array(a.data.buffer, a.data.byteOffset, a.width * a.height);
+    const dst = new Int8Array(b.data.buffer, b.data.byteOffset, b.width * b.height);
+    x0 >>= 1; y0 >>= 1; x1 = Math.min(b.width, (x1 + 1) >> 1); y1 = Math.min(b.height, (y1 + 1) >> 1);
+    for (let y = y0; y < y1; y++) {
+      const r0 = Math.min(2 * y, a.height - 1) * a.width, r1 = Math.min(2 * y + 1, a.height - 1) * a.width;
+      for (let x = x0; x < x1; x++) {
+        const c0 = Math.min(2 * x, a.width - 1), c1 = Math.min(2 * x + 1, a.width - 1);
+        dst[y * b.width + x] = Math.max(src[r0 + c0], src[r0 + c1], src[r1 + c0], src[r1 + c1]);
+      }
+    }
+  }
+}
 function updateMap(slot, d, L, info) {
   const m = L.map;
   if (!m) return;
   const e = slotObject(slot, `map ${m.w} ${m.h} ${m.res} ${m.ox} ${m.oy} ${m.oyaw}`, () => {
-    const bytes = new Uint8Array(m.cells.buffer, m.cells.byteOffset, m.w * m.h);
-    const cells = new THREE.DataTexture(bytes, m.w, m.h, THREE.RedFormat, THREE.UnsignedByteType);
-    cells.magFilter = cells.minFilter = THREE.NearestFilter; cells.generateMipmaps = false;
-    cells.unpackAlignment = 1; cells.needsUpdate = true;
+    const levels = mapLevels(m);
+    m.dirty3 = null;
+    const cells = new THREE.DataTexture(levels[0].data, m.w, m.h, THREE.RedFormat, THREE.UnsignedByteType);
+    cells.mipmaps = levels;
+    cells.magFilter = THREE.NearestFilter; cells.minFilter = THREE.NearestMipmapNearestFilter;
+    cells.generateMipmaps = false; cells.unpackAlignment = 1; cells.needsUpdate = true;
     const mat = new THREE.ShaderMaterial({
       uniforms: { cells: { value: cells }, palette: { value: paletteTexture(d.options.color_scheme) }, alpha: { value: 1 } },
       vertexShader: MAP_VERTEX, fragmentShader: MAP_FRAGMENT, transparent: true, depthWrite: false, side: THREE.DoubleSide,
@@ -190,7 +227,10 @@ function updateMap(slot, d, L, info) {
     return g;
   });
   const u = e.obj.userData;
-  if (u.version !== m.version) { u.cells.needsUpdate = true; u.version = m.version; }
+  if (u.version !== m.version) {
+    if (m.dirty3) { reduceLevels(u.cells.mipmaps, ...m.dirty3); m.dirty3 = null; }
+    u.cells.needsUpdate = true; u.version = m.version;
+  }
   if (u.scheme !== d.options.color_scheme) {
     u.mat.uniforms.palette.value.dispose();
     u.mat.uniforms.palette.value = paletteTexture(d.options.color_scheme);
@@ -442,8 +482,10 @@ function placeLabels(camera, w, h) {
     el.style.cssText = "position:absolute;font:11px sans-serif;color:#fff;background:rgba(0,0,0,0.45);padding:0 3px;white-space:nowrap";
     labels.appendChild(el); labelPool.push(el);
   }
-  labelPool.forEach((el, i) => {
-    const q = placed[i];
+  labelPool.forEach((el, i) => {  // the DOM is touched only where a label changed (style writes cost paint)
+    const q = placed[i], want = q ? `${q.name} ${q.x.toFixed(0)} ${q.y.toFixed(0)}` : "";
+    if (el.dataset.was === want) return;
+    el.dataset.was = want;
     if (!q) { el.style.display = "none"; return; }
     el.style.display = "block"; el.textContent = q.name;
     el.style.transform = `translate(${q.x.toFixed(0)}px, ${q.y.toFixed(0)}px)`;
@@ -587,6 +629,12 @@ function frame() {
     if (cam.resolution !== r) renderer.setPixelRatio(cam.resolution * (window.devicePixelRatio || 1));
   }
 }
+// benchmarks: n frames rendered back to back, each waited for (a one-pixel read), in ms per frame
+viz.renderSync = (n) => {
+  const gl = renderer.getContext(), px = new Uint8Array(4), t0 = performance.now();
+  for (let i = 0; i < n; i++) { renderer.render(scene, camera); gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, px); }
+  return (performance.now() - t0) / n;
+};
 const sel = document.getElementById("view-mode");
 if (sel) sel.onchange = () => setMode(sel.value);
 requestAnimationFrame(frame);
