@@ -236,7 +236,9 @@ def _colours(
             state.status["Color Transformer"] = ("warn", f"no channel {name!r}: drawn flat")
         else:
             state.status["Color Transformer"] = ("ok", f"Intensity of {name!r}")
-    elif transformer == "AxisColor":
+    else:
+        state.status.pop("Color Transformer", None)
+    if transformer == "AxisColor":
         frame = world if bool(cfg.option("use_fixed_frame")) else local
         values = frame[:, _AXES[str(cfg.option("axis"))]] if len(frame) else None
     idx, palette, bounds = color_buckets(
