@@ -20,7 +20,8 @@ import time
 from pathlib import Path
 
 from roverlab.slam.data import read_g2o
-from roverlab.slam.data.posegraph import chi2, optimize
+from roverlab.slam.data.pose_solver import optimize
+from roverlab.slam.data.posegraph import chi2
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "posegraphs"
 GRAPHS = {  # file -> reference chi2 (the SE-Sync / g2o papers' optima)

@@ -54,6 +54,14 @@ def _rss_kb(pid: int) -> int:
     return 0
 
 
+def _js_heap_mb(cdp: Any) -> float:
+    """The page's JavaScript heap after a full garbage collection, MB (0 without a page)."""
+    if cdp is None:
+        return 0.0
+    cdp.send("HeapProfiler.collectGarbage")
+    return float(cdp.send("Runtime.getHeapUsage")["usedSize"]) / 2**20
+
+
 def _descendants(pid: int) -> list[int]:
     """Every process below ``pid`` (chromium's zygote, renderer and GPU processes)."""
     children: dict[int, list[int]] = defaultdict(list)
@@ -148,7 +156,7 @@ def main() -> int:
     story.start()
     watcher = Watcher(context, 300.0)
     context.spin_in_thread()
-    pw = browser = page = None
+    pw = browser = page = cdp = None
     page_errors: list[str] = []
     if not args.no_browser:
         if not CHROMIUM.is_file():
@@ -160,11 +168,13 @@ def main() -> int:
         page = browser.new_page(viewport={"width": 1280, "height": 800})
         page.on("pageerror", lambda e: page_errors.append(str(e)))
         page.goto(server.url)
+        cdp = page.context.new_cdp_session(page)
     t_wall = time.perf_counter()
     start_sample = watcher.sample()
     watcher.thread.start()
     stages: dict[str, str] = {}
     patrol_start: tuple[float, int, int] | None = None
+    heap_start = 0.0
     try:
         for name, fn in (
             ("explore", story.explore),
@@ -184,6 +194,7 @@ def main() -> int:
         ender.start()
         context.wait_for(lambda: True, 60.0)  # warm-up of the new stack
         patrol_start = watcher.sample()
+        heap_start = _js_heap_mb(cdp)
         story.patrol()
         stages["patrol"] = "ok"
     except Exception as err:  # reported, the figures still printed
@@ -191,6 +202,7 @@ def main() -> int:
             f"failed: {err}"
         )
     end_sample = watcher.sample()
+    heap_end = _js_heap_mb(cdp)
     watcher.done.set()
     wall = time.perf_counter() - t_wall
     story.on_executor(recorder.close)
@@ -217,8 +229,10 @@ def main() -> int:
           f"(t = {base[0]:.0f} s) {base[1] / 1024:.1f} MB, end {end_sample[1] / 1024:.1f} MB: "
           f"growth {100 * growth:+.1f} % (target < {100 * GROWTH_TARGET:.0f} %)")  # fmt: skip
     if not args.no_browser:
-        print(f"memory, chromium: patrol start {base[2] / 1024:.1f} MB, end "
-              f"{end_sample[2] / 1024:.1f} MB ({100 * b_growth:+.1f} %)")  # fmt: skip
+        print(f"memory, chromium (all its processes): patrol start {base[2] / 1024:.1f} MB, "
+              f"end {end_sample[2] / 1024:.1f} MB ({100 * b_growth:+.1f} %); the page's "
+              f"JavaScript heap after garbage collection: {heap_start:.1f} MB -> "
+              f"{heap_end:.1f} MB")  # fmt: skip
     watcher.count_drops()
     drops = dict(sorted(watcher.dropped.items()))
     print("dropped by subscription queues: "

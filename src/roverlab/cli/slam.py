@@ -24,7 +24,8 @@ from roverlab.errors import RoverlabError
 from roverlab.slam.data.errors import LogError
 from roverlab.slam.data.evaluation import evaluate, read_relations
 from roverlab.slam.data.logs import load_log
-from roverlab.slam.data.posegraph import chi2, optimize, read_g2o, write_g2o
+from roverlab.slam.data.pose_solver import optimize
+from roverlab.slam.data.posegraph import chi2, read_g2o, write_g2o
 from roverlab.slam.data.trajectory import read_tum, write_tum
 
 __all__ = ["app", "eval_command", "graph_command", "main", "odometry_command"]

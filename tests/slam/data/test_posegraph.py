@@ -20,7 +20,7 @@ from roverlab.slam.data import (
     read_g2o,
     write_g2o,
 )
-from roverlab.slam.data import posegraph as pg
+from roverlab.slam.data import pose_solver as pg
 
 
 def graph_of(

@@ -26,14 +26,12 @@ from .logs import (
     read_bag,
     read_clf,
 )
+from .pose_solver import OptimizationReport, chordal_initialisation, optimize
 from .posegraph import (
-    OptimizationReport,
     PoseGraph,
     chi2,
-    chordal_initialisation,
     edge_errors,
     odometry_initialisation,
-    optimize,
     read_g2o,
     write_g2o,
 )

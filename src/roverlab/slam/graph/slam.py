@@ -22,7 +22,7 @@ Per scan (:meth:`GraphSLAM.process`):
    match with response above ``loop_match_minimum_response_coarse`` and x/y variance
    below ``loop_match_maximum_variance_coarse`` is matched again finely, and with a
    response of at least ``loop_match_minimum_response_fine`` becomes an edge;
-5. after new loop edges the graph is optimised (:func:`roverlab.slam.data.posegraph.optimize`,
+5. after new loop edges the graph is optimised (:func:`roverlab.slam.data.pose_solver.optimize`,
    sparse Gauss-Newton / Levenberg-Marquardt, warm-started). A consistency check guards
    against a wrong closure: if afterwards a loop or near-chain edge is off by more than
    ``loop_closure_max_residual``, the new closures are dropped and the poses restored.
@@ -57,7 +57,8 @@ from scipy.sparse.csgraph import breadth_first_order
 from roverlab.geometry import SE2
 from roverlab.maps.grid import CountGrid
 from roverlab.slam.common import ScanLike
-from roverlab.slam.data.posegraph import PoseGraph, edge_errors, optimize
+from roverlab.slam.data.pose_solver import optimize
+from roverlab.slam.data.posegraph import PoseGraph, edge_errors
 from roverlab.slam.data.trajectory import Trajectory
 from roverlab.slam.graph.errors import GraphSlamInputError
 from roverlab.slam.graph.matcher import (
