@@ -92,26 +92,6 @@ def test_escape_from_a_lethal_cell_under_the_footprint(dwa_params: DWAParams) ->
         DWAPlanner(dwa_params, footprint=fp).compute_velocity(pose, Velocity2D(), plan, boxed)
 
 
-def test_nose_goal_stops_short_of_a_wall(dwa_params: DWAParams) -> None:
-    """A goal 0.25 m from a wall (the held-out corridor's goal 7): moved the full
-    forward_point_distance (0.325 m) from the robot, the nose goal lies in the wall's
-    inscribed band, its wavefront cannot leave the band and the goal-front critic sees every
-    free cell as unreachable (DWA spun in place 0.15 m from the goal). It stops before the
-    band, so the grid leads to the goal."""
-    cm = _open()
-    wall_row = int(2.0 / 0.05)
-    cm.costs[wall_row:, :] = 254
-    cm.costs[wall_row - 2 : wall_row, :] = 253  # inscribed band
-    dwa = DWAPlanner(dwa_params, footprint=FOOT)
-    plan = np.array([[1.5, 1.2, math.pi / 2], [1.5, 1.5, math.pi / 2], [1.5, 1.75, math.pi / 2]])
-    dwa.compute_velocity(SE2(1.5, 1.2, math.pi / 2), Velocity2D(), plan, cm)
-    front = dwa._grids[2]
-    size = cm.size_x * cm.size_y
-    here = front[int(1.2 / 0.05), int(1.5 / 0.05)]
-    assert here < size  # reachable from the nose goal
-    assert front[int(1.2 / 0.05), int(1.5 / 0.05)] > front[int(1.7 / 0.05), int(1.5 / 0.05)]
-
-
 def test_rotate_in_place_at_the_goal_then_reached(dwa_params: DWAParams) -> None:
     dwa = DWAPlanner(dwa_params, footprint=FOOT)
     cm = _open()

@@ -84,25 +84,6 @@ def _adjust_resolution(plan: NDArray[np.float64], resolution: float) -> NDArray[
     return np.concatenate(out)
 
 
-def _free_shift(cm: Costmap2D, gx: float, gy: float, ang: float, distance: float) -> float:
-    """How far the nose goal moves from the local goal ``(gx, gy)`` along ``ang``: up to
-    ``distance`` (``forward_point_distance``), in half-cell steps, stopping before a lethal,
-    inscribed or unknown cell (a roverlab change: ROS moves it the full distance, into a
-    wall when the goal is within that distance of one; the goal-front grid's wavefront
-    then cannot leave the wall, every free cell is unreachable, and DWA spun in place
-    0.15 m from such a goal until move_base aborted)."""
-    step = cm.resolution / 2.0
-    c, s = math.cos(ang), math.sin(ang)
-    d = 0.0
-    while d < distance - 1e-9:
-        nxt = min(d + step, distance)
-        cell = cm.world_to_map(gx + nxt * c, gy + nxt * s)
-        if cell is None or cm.costs[cell[1], cell[0]] >= INSCRIBED_INFLATED_OBSTACLE:
-            break
-        d = nxt
-    return d
-
-
 class DWAPlanner:
     """DWAPlannerROS.
 
@@ -223,10 +204,9 @@ class DWAPlanner:
         target_distance(cm.costs, np.ascontiguousarray(cells[end - 1 : end]), goal_grid)
         g = plan[-1]
         ang = math.atan2(g[1] - pose.y, g[0] - pose.x)
-        shift = _free_shift(cm, float(g[0]), float(g[1]), ang, p.forward_point_distance)
         front = plan.copy()
-        front[-1, 0] += shift * math.cos(ang)
-        front[-1, 1] += shift * math.sin(ang)
+        front[-1, 0] += p.forward_point_distance * math.cos(ang)
+        front[-1, 1] += p.forward_point_distance * math.sin(ang)
         fadj = _adjust_resolution(front, res)
         fcells = np.floor((fadj - [cm.origin_x, cm.origin_y]) / res).astype(np.int64)
         fin = (
