@@ -3,7 +3,7 @@
 A synthetic room (exact ranges from :func:`roverlab.raycast.cast_2d`, noise added) driven
 twice around with drifting odometry checks the filter end to end; smaller tests pin the
 map counting, resampling, seeding and parameter rules; a slice of the Intel lab log checks
-it on real data (the whole Intel and fr079 logs are ``slow``).
+it on real data (the whole logs: ``test_real_logs.py``).
 """
 
 from __future__ import annotations
@@ -38,7 +38,6 @@ from roverlab.slam import (
     Trajectory,
     evaluate,
     iter_log,
-    load_log,
     read_relations,
 )
 
@@ -657,27 +656,3 @@ def test_intel_slice_beats_raw_odometry(tmp_path: Path) -> None:
     assert err < 0.6 * odo
     save_map_png(run.map, run.poses, tmp_path / "intel_slice.png")
     assert (tmp_path / "intel_slice.png").stat().st_size > 1000
-
-
-@pytest.mark.slow
-@pytest.mark.parametrize(
-    ("name", "interpolate", "limit_m", "max_wall_s"),
-    [
-        ("intel", False, 0.080, 270.0),
-        ("intel", True, 0.080, 270.0),
-        ("fr079", False, 0.090, 160.0),
-        ("fr079", True, 0.070, 160.0),
-    ],
-)
-def test_full_log_30_particles(
-    name: str, interpolate: bool, limit_m: float, max_wall_s: float
-) -> None:
-    """Default parameters (30 particles) over a whole log (10x real time: 269 s / 106 s)."""
-    log = load_log(_radish(name))
-    slam = GMapping(GMappingParams(), np.random.default_rng(0))
-    t0 = time.perf_counter()
-    run = slam.run_log(log, interpolate=interpolate)
-    wall = time.perf_counter() - t0
-    err, odo = _score(name, log, run.poses)
-    assert err <= limit_m, f"{name}: {err:.4f} m (odometry {odo:.3f} m)"
-    assert wall < max_wall_s

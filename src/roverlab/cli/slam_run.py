@@ -14,6 +14,7 @@ from roverlab.cli.log_input import (
     BaseFrameOption,
     FirstOption,
     LogArgument,
+    LoggedOdometryOption,
     OdomFrameOption,
     OdomTopicOption,
     ParamOption,
@@ -22,6 +23,7 @@ from roverlab.cli.log_input import (
     parse_params,
     progress,
     read_log,
+    reversing_note,
 )
 from roverlab.mapping.gmapping import GMapping, GMappingParams
 from roverlab.mapping.graph import GraphParams, GraphSLAM
@@ -31,6 +33,7 @@ from roverlab.maps import save_map
 from roverlab.maps.plot import write_map_png
 from roverlab.slam.errors import SlamError
 from roverlab.slam.logs import LaserLog
+from roverlab.slam.reversing import ReversingRepair
 from roverlab.slam.trajectory import Trajectory, write_tum
 
 METHODS = ("hector", "gmapping", "graph")
@@ -155,6 +158,7 @@ def run(
             "(what a live slam_gmapping reports).",
         ),
     ] = True,
+    logged_odometry: LoggedOdometryOption = False,
 ) -> None:
     """Map a recorded log: DIR/map.yaml + map.pgm, DIR/map.png, DIR/trajectory.tum."""
     if method not in METHODS:
@@ -168,6 +172,7 @@ def run(
     else:
         GraphParams.from_ros(params)
     started = time.monotonic()
+    reversing = None if logged_odometry else ReversingRepair()
     records = read_log(
         log,
         scan_topic=scan_topic,
@@ -177,8 +182,12 @@ def run(
         base_frame=base_frame,
         first=first,
         error=SlamError,
+        reversing=reversing,
     )
     typer.echo(f"{len(records)} scans from {log}", err=True)
+    note = reversing_note(reversing)
+    if note is not None:
+        typer.echo(note, err=True)
     if method == "hector":
         res = run_hector(records, params)
     elif method == "gmapping":
