@@ -3,7 +3,7 @@
     python benchmarks/posegraph.py [--repeat 3]
 
 Each graph in ../shared/data/posegraphs is optimised from the file's own start with
-``roverlab.slam.optimize`` (what ``roverlab slam graph`` runs), after one warm-up run;
+``roverlab.slam.data.optimize`` (what ``roverlab slam graph`` runs), after one warm-up run;
 target: city10000 (10,000 poses, 20,687 edges) <= 1 s. When GTSAM is installed (the
 ``bench`` extra), its Gauss-Newton optimiser (Levenberg-Marquardt where Gauss-Newton
 meets an indeterminate step) runs on the same graphs in the same run, with
@@ -19,8 +19,9 @@ import statistics
 import time
 from pathlib import Path
 
-from roverlab.slam import read_g2o
-from roverlab.slam.posegraph import chi2, optimize
+from roverlab.slam.data import read_g2o
+from roverlab.slam.data.pose_solver import optimize
+from roverlab.slam.data.posegraph import chi2
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "posegraphs"
 GRAPHS = {  # file -> reference chi2 (the SE-Sync / g2o papers' optima)

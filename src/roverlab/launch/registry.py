@@ -23,14 +23,14 @@ from roverlab.launch.state import LaunchState, NodeFactory
 from roverlab.launch.xml import LaunchError, NodeSpec
 from roverlab.localization.amcl.node import AmclNode
 from roverlab.localization.fake_localization import FakeLocalization
-from roverlab.mapping.gmapping.node import SlamGMapping
-from roverlab.mapping.graph.node import SlamKarto, SlamToolbox, SyncSlamToolbox
-from roverlab.mapping.hector.node import HectorMapping
 from roverlab.maps.node import MapSaver, MapServer
 from roverlab.msgs import classes as mc
 from roverlab.navigation.costmap.node import Costmap2DNode
 from roverlab.navigation.explore.node import Explore
 from roverlab.navigation.move_base.node import MoveBase
+from roverlab.slam.gmapping.node import SlamGMapping
+from roverlab.slam.graph.node import SlamKarto, SlamToolbox, SyncSlamToolbox
+from roverlab.slam.hector.node import HectorMapping
 from roverlab.viz.errors import DashboardError
 from roverlab.viz.joints import SLIDER_TOPIC
 from roverlab.viz.launcher import start_image_view, start_rviz
