@@ -344,6 +344,26 @@ def test_graph_round_trips_through_g2o(
     assert chi2(back) == pytest.approx(chi2(graph), rel=1e-9)
 
 
+def test_a_turn_the_odometry_reports_late_is_found_beyond_the_search_window() -> None:
+    """Turning 10 degrees per scan while the odometry stalls for four scans, then reports
+    the whole 50 degrees at once (mit-csail's odometry does this): the prediction of the
+    fifth scan is ~40 degrees past the truth, twice the +-20 degree window. The match lands
+    on the window's rim and is searched again from there."""
+    scene = _corridor_scene()
+    turn = math.radians(10.0)
+    truth = np.array([[5.0, 1.5, 0.0]] * 3 + [[5.0, 1.5, k * turn] for k in range(1, 10)])
+    odom = truth.copy()
+    odom[3:7, 2] = 0.0  # stalled: scans 3-6 report no turn, scan 7 catches up
+    slam = GraphSLAM(GraphParams())
+    for i, (t, o) in enumerate(zip(truth, odom, strict=True)):
+        r = cast_2d(scene, t[0], t[1], 0.5, t[2] + _ANGLES, _RANGE_MAX)
+        pose = slam.process(r, _ANGLES, o, 0.2 * i, range_max=_RANGE_MAX)
+    heading_error = abs(math.remainder(pose.theta - truth[-1, 2], 2 * math.pi))
+    assert slam.rim_searches >= 1
+    assert math.degrees(heading_error) < 1.0
+    assert math.hypot(pose.x - truth[-1, 0], pose.y - truth[-1, 1]) < 0.05
+
+
 def test_odometry_only_mapping_follows_odometry(
     corridor: tuple[list[ScanRecord], NDArray[np.float64]],
 ) -> None:

@@ -50,6 +50,8 @@ def run_graph(records: LaserLog, params: dict[str, object]) -> MethodResult:
     m = result.map
     g = slam.graph()
     notes = [f"graph: {g.num_vertices} keyframes, {g.num_edges} constraints"]
+    if slam.rim_searches:
+        notes[0] += f", {slam.rim_searches} matches searched again beyond the angular window"
     dropped = sorted(k for k in params if k in NODE_PARAMETERS)
     if dropped:  # GraphParams.from_ros accepts slam_toolbox's node settings and drops them
         notes.append(
