@@ -302,32 +302,49 @@ class SimulatorNode(Node):
     def _publish_odometry(self) -> None:
         d = self.drive
         assert d is not None
-        ns = self.get_clock().now_ns()
+        ns = self._executor.now_ns  # a timer callback: the event's time
         x, y, yaw = self.odometry_pose()
-        st = self._state
+        st = self._state.tolist()
         if d.odometry_source == "encoder":
             v = 0.5 * (st[S_VL] + st[S_VR])
             w = (st[S_VR] - st[S_VL]) / d.params.wheel_separation_m
         else:
-            v, w = self.v, self.w
+            v, w = st[S_V], st[S_W]
+        sec, nsec = divmod(ns, 1_000_000_000)
+        half = 0.5 * yaw
+        qz, qw = math.sin(half), math.cos(half)
         self.odom_pub.publish(
             mc.Odometry(
-                _header(ns, d.odometry_frame),
+                mc.Header(mc.Time(sec, nsec), d.odometry_frame),
                 d.robot_base_frame,
-                _pose_msg(x, y, yaw, self._pose_cov),
-                _twist_msg(v, w, self._twist_cov),
+                mc.PoseWithCovariance(
+                    mc.Pose(mc.Point(x, y, 0.0), mc.Quaternion(0.0, 0.0, qz, qw)), self._pose_cov
+                ),
+                mc.TwistWithCovariance(
+                    mc.Twist(mc.Vector3(v, 0.0, 0.0), mc.Vector3(0.0, 0.0, w)), self._twist_cov
+                ),
             )
         )
         if d.publish_odom_tf:
-            self.tf.send_transform(_transform(ns, d.odometry_frame, d.robot_base_frame, x, y, yaw))
+            self.tf.send_transform(
+                mc.TransformStamped(
+                    mc.Header(mc.Time(sec, nsec), d.odometry_frame),
+                    d.robot_base_frame,
+                    mc.Transform(mc.Vector3(x, y, 0.0), mc.Quaternion(0.0, 0.0, qz, qw)),
+                )
+            )
         if self.joint_pub is not None:
+            # one buffer for position, velocity and effort (each message its own)
+            k = 2.0 / d.params.wheel_diameter_m
+            values = np.array([st[S_AL], st[S_AR], st[S_VL], st[S_VR], 0.0, 0.0])
+            values[2:4] *= k
             self.joint_pub.publish(
                 mc.JointState(
-                    _header(ns, ""),
+                    mc.Header(mc.Time(sec, nsec), ""),
                     [d.left_joint, d.right_joint],
-                    np.array([st[S_AL], st[S_AR]]),
-                    np.array([st[S_VL], st[S_VR]]) * (2.0 / d.params.wheel_diameter_m),
-                    np.zeros(2),
+                    values[0:2],
+                    values[2:4],
+                    values[4:6],
                 )
             )
 

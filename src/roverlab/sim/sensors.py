@@ -23,6 +23,7 @@ __all__ = ["CameraModel", "ImuModel", "ImuNoise", "LidarModel", "LidarParams"]
 F64 = NDArray[np.float64]
 GRAVITY = 9.80665
 _BLOCK = 1024
+_SCAN_BLOCK = 64
 
 
 @dataclass(frozen=True, slots=True)
@@ -73,16 +74,28 @@ class LidarModel:
         self.params = params
         self.rng = rng
         self._rel = params.angles()
+        # noise rows drawn _SCAN_BLOCK scans at a time: the same numbers, in the same
+        # order, as one draw per scan (the generator serves nobody else)
+        self._noise: F64 = np.full((1, params.samples), params.noise_mean)
+        self._row = 0 if params.noise_stddev <= 0 else 1
+
+    def _noise_row(self) -> F64:
+        p = self.params
+        if p.noise_stddev <= 0:
+            return self._noise[0]
+        if self._row >= self._noise.shape[0]:
+            self._noise = self.rng.normal(p.noise_mean, p.noise_stddev, (_SCAN_BLOCK, p.samples))
+            self._row = 0
+        row = self._noise[self._row]
+        self._row += 1
+        return row
 
     def scan(self, scene: Scene, x: float, y: float, z: float, yaw: float) -> NDArray[np.float32]:
         p = self.params
         ranges = cast_2d(scene, x, y, z, self._rel + yaw, p.range_max)
-        noise = (
-            self.rng.normal(p.noise_mean, p.noise_stddev, ranges.shape)
-            if p.noise_stddev > 0
-            else np.full(ranges.shape, p.noise_mean)
+        return _finish_scan(
+            ranges, self._noise_row(), p.range_min, p.range_max, p.range_resolution
         )
-        return _finish_scan(ranges, noise, p.range_min, p.range_max, p.range_resolution)
 
 
 @numba.njit(cache=True, nogil=True)
