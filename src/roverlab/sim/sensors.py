@@ -93,9 +93,7 @@ class LidarModel:
     def scan(self, scene: Scene, x: float, y: float, z: float, yaw: float) -> NDArray[np.float32]:
         p = self.params
         ranges = cast_2d(scene, x, y, z, self._rel + yaw, p.range_max)
-        return _finish_scan(
-            ranges, self._noise_row(), p.range_min, p.range_max, p.range_resolution
-        )
+        return _finish_scan(ranges, self._noise_row(), p.range_min, p.range_max, p.range_resolution)
 
 
 @numba.njit(cache=True, nogil=True)
