@@ -40,8 +40,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from roverlab.raycast.accel import scene_grid
-from roverlab.raycast.camera_fill import fill_level, fill_pitched
+from roverlab.raycast.camera_fill import fill_pitched
 from roverlab.raycast.camera_hits import MAX_LAYERS, collect_hits
+from roverlab.raycast.camera_level import fill_level
 from roverlab.raycast.errors import RaycastInputError
 from roverlab.raycast.scene import Scene
 
@@ -53,6 +54,7 @@ __all__ = [
     "depth_to_points",
     "optical_to_body",
     "render",
+    "render_rgb",
 ]
 
 _jit = numba.njit(cache=True, nogil=True)
@@ -134,8 +136,9 @@ def _render_kernel(
     nseg: int,
     rgb: NDArray[np.uint8],
     depth: NDArray[np.float32],
+    with_depth: bool,
 ) -> None:
-    width = depth.shape[1]
+    width = rgb.shape[1]
     ct = math.cos(pitch)
     st = math.sin(pitch)
     # image rows in the camera's vertical plane: direction (hx, 0, vz) per unit depth
@@ -170,7 +173,7 @@ def _render_kernel(
             x, y, z, yaw, fx, fy, cx, cy, near, far,
             segz, segtex, circz, tex_data, tex_off, tex_shape,
             floor_rgb, sky_rgb, nseg,
-            n_hits, h_in, h_out, h_id, h_u, h_shade, h_rgb, rgb, depth,
+            n_hits, h_in, h_out, h_id, h_u, h_shade, h_rgb, rgb, depth, with_depth,
         )  # fmt: skip
     else:
         fill_pitched(
@@ -251,7 +254,65 @@ def render(
         RaycastInputError: non-finite pose, bad size, field of view, clip range or pitch.
     """
     intr = camera_intrinsics(width, height, hfov)
-    vals = [float(v) for v in (x, y, z, yaw, pitch)]
+    depth = np.empty((intr.height, intr.width), dtype=np.float32)
+    rgb = _render(scene, (x, y, z, yaw, pitch), intr, near, far, None, depth)
+    return rgb, depth
+
+
+def render_rgb(
+    scene: Scene,
+    x: float,
+    y: float,
+    z: float,
+    yaw: float,
+    *,
+    hfov: float,
+    width: int,
+    height: int,
+    near: float,
+    far: float,
+    pitch: float = 0.0,
+    out: NDArray[np.uint8] | None = None,
+) -> NDArray[np.uint8]:
+    """:func:`render`'s RGB image alone (a level camera then skips the depth image).
+
+    Args:
+        out: an (H, W, 3) C-contiguous uint8 array to render into (every pixel is
+            written), or None for a new one.
+
+    Raises:
+        RaycastInputError: as :func:`render`; an ``out`` of another shape or type.
+    """
+    intr = camera_intrinsics(width, height, hfov)
+    if out is not None and (
+        out.shape != (intr.height, intr.width, 3)
+        or out.dtype != np.uint8
+        or not out.flags.c_contiguous
+    ):
+        raise RaycastInputError(
+            f"out must be a C-contiguous ({intr.height}, {intr.width}, 3) uint8 array, "
+            f"got {out.dtype} {out.shape}"
+        )
+    level = float(pitch) == 0.0
+    depth = _NO_DEPTH if level else np.empty((intr.height, intr.width), dtype=np.float32)
+    return _render(scene, (x, y, z, yaw, pitch), intr, near, far, out, depth)
+
+
+_NO_DEPTH = np.zeros((1, 1), dtype=np.float32)
+
+
+def _render(
+    scene: Scene,
+    pose: tuple[float, float, float, float, float],
+    intr: CameraIntrinsics,
+    near: float,
+    far: float,
+    out: NDArray[np.uint8] | None,
+    depth: NDArray[np.float32],
+) -> NDArray[np.uint8]:
+    """Validate and render into ``out`` (or a new image); ``depth`` is filled unless it
+    is ``_NO_DEPTH`` (a level camera only)."""
+    vals = [float(v) for v in pose]
     if not all(math.isfinite(v) for v in vals):
         raise RaycastInputError(f"camera pose must be finite, got {vals}")
     x_, y_, z_, yaw_, pitch_ = vals
@@ -265,8 +326,7 @@ def render(
         )
     g = scene_grid(scene)
     tex_data, tex_off, tex_shape = _packed_textures(scene)
-    rgb = np.empty((intr.height, intr.width, 3), dtype=np.uint8)
-    depth = np.empty((intr.height, intr.width), dtype=np.float32)
+    rgb = np.empty((intr.height, intr.width, 3), dtype=np.uint8) if out is None else out
     _render_kernel(
         x_, y_, z_, yaw_, pitch_, intr.fx, intr.fy, intr.cx, intr.cy, near_, far_,
         scene.segments, scene.segment_z, scene.segment_rgb, scene.segment_texture,
@@ -274,9 +334,9 @@ def render(
         tex_data, tex_off, tex_shape,
         _rgb3("floor_rgb", scene.floor_rgb), _rgb3("sky_rgb", scene.sky_rgb),
         g.x0, g.y0, g.cell, g.nx, g.ny, g.cell_start, g.items, g.n_segments,
-        rgb, depth,
+        rgb, depth, depth is not _NO_DEPTH,
     )  # fmt: skip
-    return rgb, depth
+    return rgb
 
 
 def depth_to_points(

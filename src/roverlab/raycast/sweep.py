@@ -60,42 +60,6 @@ def fan_step(angles: NDArray[np.float64]) -> float:
 
 
 @_jit
-def _test_arc(
-    start: float,
-    width: float,
-    phi0: float,
-    step: float,
-    n: int,
-    ox: float,
-    oy: float,
-    z: float,
-    dxs: NDArray[np.float64],
-    dys: NDArray[np.float64],
-    kind: int,
-    p0: float,
-    p1: float,
-    p2: float,
-    p3: float,
-    out: NDArray[np.float64],
-) -> None:
-    """Test the primitive against every beam whose direction lies in the arc
-    ``[start, start + width]`` (any turn of it), two beams of margin on each side."""
-    # bring the arc's start into [phi0, phi0 + 2 pi); then the turns before and after
-    s = start - _TWO_PI * math.floor((start - phi0) / _TWO_PI)
-    for turn in range(-1, 2):
-        lo = s + turn * _TWO_PI - _ARC_MARGIN
-        hi = lo + width + 2.0 * _ARC_MARGIN
-        k0 = int(math.floor((lo - phi0) / step)) - 2
-        k1 = int(math.ceil((hi - phi0) / step)) + 2
-        if k0 < 0:
-            k0 = 0
-        if k1 > n - 1:
-            k1 = n - 1
-        for k in range(k0, k1 + 1):
-            _test_one(k, ox, oy, dxs, dys, kind, p0, p1, p2, p3, out)
-
-
-@_jit
 def _test_one(
     k: int,
     ox: float,
@@ -103,18 +67,35 @@ def _test_one(
     dxs: NDArray[np.float64],
     dys: NDArray[np.float64],
     kind: int,
-    p0: float,
-    p1: float,
-    p2: float,
-    p3: float,
+    p: NDArray[np.float64],
     out: NDArray[np.float64],
 ) -> None:
     if kind == 0:
-        t = segment_distance(ox, oy, dxs[k], dys[k], p0, p1, p2, p3, out[k])
+        t = segment_distance(ox, oy, dxs[k], dys[k], p[0], p[1], p[2], p[3], out[k])
     else:
-        t, _ = circle_hit(ox, oy, dxs[k], dys[k], p0, p1, p2)
+        t, _ = circle_hit(ox, oy, dxs[k], dys[k], p[0], p[1], p[2])
     if t < out[k]:
         out[k] = t
+
+
+@_jit
+def _test_range(
+    k0: int,
+    k1: int,
+    skip: float,
+    ox: float,
+    oy: float,
+    dxs: NDArray[np.float64],
+    dys: NDArray[np.float64],
+    kind: int,
+    p: NDArray[np.float64],
+    out: NDArray[np.float64],
+) -> None:
+    """Beams ``k0..k1``; those already holding a hit nearer than ``skip`` (below the
+    primitive's nearest distance, with room for rounding) cannot change and are passed."""
+    for k in range(max(k0, 0), min(k1, out.shape[0] - 1) + 1):
+        if out[k] >= skip:
+            _test_one(k, ox, oy, dxs, dys, kind, p, out)
 
 
 @_jit
@@ -134,13 +115,25 @@ def sweep_fan(
     out: NDArray[np.float64],
 ) -> None:
     """Nearest hit per beam of a uniform fan (``phi0 + i * step``, unit directions
-    ``dxs``/``dys``) into ``out`` (``inf``: none within ``rmax``), as the grid walk."""
+    ``dxs``/``dys``) into ``out`` (``inf``: none within ``rmax``), as the grid walk.
+
+    First every primitive in the laser's plane and within reach gets its nearest
+    distance and its arc (or "every beam" when the sensor is on or next to it); then the
+    primitives are taken nearest first, so most beams behind a nearer hit are passed
+    with one comparison.
+    """
     n = dxs.shape[0]
     for k in range(n):
         out[k] = math.inf
-    reach2 = (rmax * (1.0 + 1e-9) + 1e-9) ** 2
+    nseg = segs.shape[0]
+    total = nseg + circs.shape[0]
+    reach = rmax * (1.0 + 1e-9) + 1e-9
     near = _NEAR * (1.0 + abs(ox) + abs(oy))
-    for it in range(segs.shape[0]):
+    dmin = np.empty(total)
+    start = np.empty(total)
+    width = np.empty(total)  # < 0: every beam
+    keep = np.zeros(total, dtype=np.bool_)
+    for it in range(nseg):
         if z < segz[it, 0] or z > segz[it, 1]:
             continue
         x0 = segs[it, 0]
@@ -162,24 +155,24 @@ def sweep_fan(
             f = min(1.0, max(0.0, -(px * wx + py * wy) / ll))
         cx = px + f * wx
         cy = py + f * wy
-        if cx * cx + cy * cy > reach2:
+        d = math.sqrt(cx * cx + cy * cy)
+        if d > reach:
             continue
-        cross = px * qy - py * qx
-        dot = px * qx + py * qy
+        keep[it] = True
+        dmin[it] = d
         el = math.sqrt(ex * ex + ey * ey)
         if el == 0.0 or abs(ex * (oy - y0) - ey * (ox - x0)) <= near * el:
             # the sensor on (or next to) the segment's line: the arc is ill-conditioned
-            # there, every beam is tested
-            for k in range(n):
-                _test_one(k, ox, oy, dxs, dys, 0, x0, y0, x1, y1, out)
+            width[it] = -1.0
             continue
+        cross = px * qy - py * qx
+        dot = px * qx + py * qy
         if cross > 0.0:
-            start = math.atan2(py, px)
-            width = math.atan2(cross, dot)
+            start[it] = math.atan2(py, px)
+            width[it] = math.atan2(cross, dot)
         else:
-            start = math.atan2(qy, qx)
-            width = math.atan2(-cross, dot)
-        _test_arc(start, width, phi0, step, n, ox, oy, z, dxs, dys, 0, x0, y0, x1, y1, out)
+            start[it] = math.atan2(qy, qx)
+            width[it] = math.atan2(-cross, dot)
     for j in range(circs.shape[0]):
         if z < circz[j, 0] or z > circz[j, 1]:
             continue
@@ -187,18 +180,43 @@ def sweep_fan(
         ccy = circs[j, 1] - oy
         r = circs[j, 2]
         dist = math.sqrt(ccx * ccx + ccy * ccy)
-        if dist - r > math.sqrt(reach2):
+        if dist - r > reach:
             continue
+        i = nseg + j
+        keep[i] = True
+        dmin[i] = max(dist - r, 0.0)
         if dist - r <= near:
-            for k in range(n):
-                _test_one(k, ox, oy, dxs, dys, 1, circs[j, 0], circs[j, 1], r, 0.0, out)
+            width[i] = -1.0
             continue
         half = math.asin(min(1.0, r / dist))
-        start = math.atan2(ccy, ccx) - half
-        _test_arc(
-            start, 2.0 * half, phi0, step, n, ox, oy, z, dxs, dys, 1,
-            circs[j, 0], circs[j, 1], r, 0.0, out,
-        )  # fmt: skip
+        start[i] = math.atan2(ccy, ccx) - half
+        width[i] = 2.0 * half
+    order = np.argsort(np.where(keep, dmin, math.inf))
+    prim = np.empty(4)
+    for idx in range(total):
+        it = order[idx]
+        if not keep[it]:
+            break
+        if it < nseg:
+            kind = 0
+            for c in range(4):
+                prim[c] = segs[it, c]
+        else:
+            kind = 1
+            for c in range(3):
+                prim[c] = circs[it - nseg, c]
+        skip = dmin[it] * (1.0 - 1e-9) - 1e-12
+        if width[it] < 0.0:
+            _test_range(0, n - 1, skip, ox, oy, dxs, dys, kind, prim, out)
+            continue
+        # the arc, brought to start in [phi0, phi0 + 2 pi), and its turns before and after
+        s = start[it] - _TWO_PI * math.floor((start[it] - phi0) / _TWO_PI)
+        for turn in range(-1, 2):
+            lo = s + turn * _TWO_PI - _ARC_MARGIN
+            hi = lo + width[it] + 2.0 * _ARC_MARGIN
+            k0 = int(math.floor((lo - phi0) / step)) - 2
+            k1 = int(math.ceil((hi - phi0) / step)) + 2
+            _test_range(k0, k1, skip, ox, oy, dxs, dys, kind, prim, out)
     for k in range(n):
         if out[k] > rmax:
             out[k] = math.inf

@@ -465,7 +465,7 @@ class SimulatorNode(Node):
         def tick() -> None:
             ns = self.get_clock().now_ns()
             x, y, z, yaw, pitch = self.sensor_pose(sensor.mount)
-            rgb, _ = model.capture(self.scene, x, y, z, yaw, pitch)
+            rgb = model.capture_rgb(self.scene, x, y, z, yaw, pitch)
             image_pub.publish(_image(ns, sensor.frame_id, rgb, "rgb8"))
             info_pub.publish(self._camera_info(ns, sensor.frame_id, model))
 
