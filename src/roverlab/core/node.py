@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import difflib
+import heapq
 import threading
 from collections import deque
 from collections.abc import Callable, Iterable, Mapping
@@ -186,7 +187,7 @@ class _TimerFire:
         if nxt <= now:  # the clock jumped past whole periods: skip them, as rcl does
             nxt += ((now - nxt) // period + 1) * period
         timer._next_ns = nxt
-        ex.call_at(nxt, self)
+        heapq.heappush(ex._heap, (nxt, next(ex._seq), self))  # ex.call_at, inlined
         timer.callback()
 
 

@@ -42,6 +42,7 @@ from roverlab.sim.dynamics import (
     S_Y,
     STATE_SIZE,
     advance,
+    compiled_entry,
 )
 from roverlab.sim.physics import DiffDriveParams
 from roverlab.sim.sensors import CameraModel, ImuModel, LidarModel
@@ -172,6 +173,19 @@ class SimulatorNode(Node):
                 inner_radius(self._footprint),
             ]
         )
+        self._dt = self._step_ns / 1e9
+        self._advance = compiled_entry(
+            advance,
+            self._state,
+            self._params,
+            0,
+            self._dt,
+            self._footprint,
+            self.obstacles.segments,
+            self.obstacles.circles,
+            self._noise,
+            0,
+        )
         self.tf = TransformBroadcaster(self)
         self._mounts: dict[int, tuple[float, float, float, float, float]] = {}
         if self.drive is not None:
@@ -244,11 +258,11 @@ class SimulatorNode(Node):
             self._noise_pos = 0
         while steps > 0:
             chunk = min(steps, self._slip_block - self._noise_pos)
-            self._noise_pos = advance(
+            self._noise_pos = self._advance(
                 self._state,
                 self._params,
                 chunk,
-                self._step_ns / 1e9,
+                self._dt,
                 self._footprint,
                 self.obstacles.segments,
                 self.obstacles.circles,
