@@ -46,8 +46,8 @@ from roverlab.msgs import Twist, xytheta_from_pose
 from roverlab.msgs import classes as mc
 from roverlab.raycast import cast_grid
 from roverlab.sim.app import Simulation
-from roverlab.slam.logs import load_log
-from roverlab.slam.mapquality import OccupancyMapLike, align_map, ground_truth
+from roverlab.slam.data.logs import load_log
+from roverlab.slam.data.mapquality import OccupancyMapLike, align_map, ground_truth
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "radish"
 FIXTURES = Path(__file__).resolve().parents[1] / "tests" / "localization" / "amcl" / "fixtures"
@@ -301,7 +301,7 @@ def crop_map(yaml_path: Path, prefix: Path, margin_cells: int = 20) -> Path:
 
 def map_alignment(map_yaml: Path) -> SE2:
     """``world_T_map`` of a SLAM map of the maze: the rigid fit of its cells to the world's
-    ground truth (:func:`roverlab.slam.mapquality.align_map`); amcl localises in the map's
+    ground truth (:func:`roverlab.slam.data.mapquality.align_map`); amcl localises in the map's
     frame, so its poses are compared with the ground truth through this."""
     ctx = Context()
     sim = Simulation(context=ctx, world="maze", robot="mybot", cameras=False)
@@ -316,8 +316,8 @@ def map_alignment(map_yaml: Path) -> SE2:
 def make_gmapping_fixture() -> Path:
     """Map the maze with slam_gmapping over the whole tour and save it (map_saver's
     files) as the tests' fixture. Run once; the result is committed."""
-    from roverlab.mapping.gmapping.node import SlamGMapping
     from roverlab.maps.node import MapSaver
+    from roverlab.slam.gmapping.node import SlamGMapping
 
     ctx = Context()
     sim = Simulation(context=ctx, world="maze", robot="mybot", cameras=False, seed=0)

@@ -26,7 +26,7 @@ TARGETS = {"hector": 20.0, "gmapping": 10.0, "graph": 15.0}
 def child(method: str, log: str) -> None:
     """One method on one log with default parameters, exactly as ``roverlab slam run``."""
     from roverlab.cli import slam_run
-    from roverlab.slam.logs import load_log
+    from roverlab.slam.data.logs import load_log
 
     t0 = time.perf_counter()
     records = load_log(log)

@@ -19,8 +19,8 @@ from roverlab.maps import save_map
 from roverlab.world import load_world
 
 MAPS = (
-    ("bingda_tutorials", "world/maze.world", "src/roverlab/robots/robot_navigation/maps/mazemap"),
-    ("mbot_description", "worlds/hui.world", "src/roverlab/robots/mbot_navigation/maps/hui"),
+    ("bingda_tutorials", "world/maze.world", "src/roverlab/packages/robot_navigation/maps/mazemap"),
+    ("mbot_description", "worlds/hui.world", "src/roverlab/packages/mbot_navigation/maps/hui"),
 )
 
 

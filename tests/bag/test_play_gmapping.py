@@ -12,11 +12,11 @@ import numpy as np
 from roverlab.bag import McapRecorder
 from roverlab.core import Context, QoSProfile
 from roverlab.core.transport.zenoh import ZenohOptions, ZenohTransport
-from roverlab.mapping.gmapping.node import SlamGMapping
 from roverlab.msgs import classes as mc
 from roverlab.msgs.factory import Twist
 from roverlab.sim.app import Simulation
 from roverlab.sim.node import SpawnPose
+from roverlab.slam.gmapping.node import SlamGMapping
 from roverlab.world.yaml_world import world_from_dict
 from tests.helpers.procs import Proc
 

@@ -14,7 +14,7 @@ from roverlab.cli.amcl_run import start_pose
 from roverlab.cli.main import main
 from roverlab.geometry import SE2
 from roverlab.maps import save_map
-from roverlab.slam.trajectory import Trajectory, write_tum
+from roverlab.slam.data.trajectory import Trajectory, write_tum
 
 DATA = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "radish"
 INTEL = DATA / "intel.clf.bz2"

@@ -76,7 +76,7 @@ def test_gmapping_on_an_intel_slice_is_seeded_and_scores(tmp_path: Path) -> None
 def test_hector_map_is_sized_to_the_odometry_unless_set() -> None:
     from roverlab.cli.slam_run import hector_auto_size
     from roverlab.geometry import SE2
-    from roverlab.slam.logs import LaserLog, ScanRecord
+    from roverlab.slam.data.logs import LaserLog, ScanRecord
 
     recs = [
         ScanRecord(timestamp=float(i), ranges=np.ones(10, np.float32), angle_min=-1.0,
@@ -103,7 +103,7 @@ def test_hector_grows_its_map_when_the_log_has_no_odometry() -> None:
     from roverlab.cli.slam_run import run_hector
     from roverlab.geometry import SE2
     from roverlab.raycast import Scene, cast_2d
-    from roverlab.slam.logs import LaserLog, ScanRecord
+    from roverlab.slam.data.logs import LaserLog, ScanRecord
 
     box = [[-2.0, -1.0, 42.0, -1.0], [-2.0, 1.0, 42.0, 1.0], [-2.0, -1.0, -2.0, 1.0],
            [42.0, -1.0, 42.0, 1.0]]  # fmt: skip
@@ -159,7 +159,7 @@ def test_graph_parameter_errors_come_before_reading_the_log(tmp_path: Path) -> N
 def test_graph_node_settings_are_named_as_ignored_offline() -> None:
     from roverlab.cli.slam_run import run_graph
     from roverlab.geometry import SE2
-    from roverlab.slam.logs import LaserLog, ScanRecord
+    from roverlab.slam.data.logs import LaserLog, ScanRecord
 
     beams = np.linspace(-1.5, 1.5, 181)
     recs = [

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from roverlab.robots import BUNDLED_PACKAGES_DIR
+from roverlab.packages import BUNDLED_PACKAGES_DIR
 
 MYBOT_URDF = BUNDLED_PACKAGES_DIR / "bingda_tutorials" / "urdf" / "mybot.urdf"
 MYBOT_XACRO = BUNDLED_PACKAGES_DIR / "bingda_tutorials" / "urdf" / "mybot.xacro"

@@ -7,8 +7,8 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
+from roverlab.cli.description import app, parse_mappings
 from roverlab.description import DescriptionError
-from roverlab.description.cli import app, parse_mappings
 from tests.description.conftest import MYBOT_URDF, MYBOT_XACRO, robot
 
 runner = CliRunner()

@@ -15,7 +15,7 @@ from roverlab.description import (
     package_search_path,
     resolve_uri,
 )
-from roverlab.robots import BUNDLED_PACKAGES_DIR
+from roverlab.packages import BUNDLED_PACKAGES_DIR
 from tests.description.conftest import MakePackage
 
 

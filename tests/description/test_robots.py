@@ -21,7 +21,7 @@ from roverlab.description import (
     format_check,
     load_robot,
 )
-from roverlab.robots import BUNDLED_PACKAGES_DIR
+from roverlab.packages import BUNDLED_PACKAGES_DIR
 from tests.description.conftest import (
     MBOT_SEED_XACRO,
     MBOT_XACRO,

@@ -21,7 +21,7 @@ from roverlab.description import (
     xacro_file,
     xacro_string,
 )
-from roverlab.robots import BUNDLED_PACKAGES_DIR
+from roverlab.packages import BUNDLED_PACKAGES_DIR
 from tests.description.conftest import MakePackage, xrobot
 
 

@@ -14,10 +14,10 @@ from hypothesis import strategies as st
 
 from roverlab.core.parameters import load_parameter_file
 from roverlab.msgs import LaserScan, deserialize, parse_yaml_message, serialize
-from roverlab.slam.evaluation import read_relations
-from roverlab.slam.logs import read_clf
-from roverlab.slam.posegraph import read_g2o
-from roverlab.slam.trajectory import read_tum
+from roverlab.slam.data.evaluation import read_relations
+from roverlab.slam.data.logs import read_clf
+from roverlab.slam.data.posegraph import read_g2o
+from roverlab.slam.data.trajectory import read_tum
 from tests.fuzz.mutation import FUZZ, clean, mutated
 
 _RANGES = " ".join(f"{1.0 + 0.01 * i:.2f}" for i in range(180))

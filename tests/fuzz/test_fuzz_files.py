@@ -19,14 +19,13 @@ from roverlab.launch.xml import load_launch
 from roverlab.maps import load_map
 from roverlab.viz.config import parse_rviz
 from roverlab.world import load_world
+from roverlab.world.loader import BUNDLED_WORLDS_DIR
 from tests.fuzz.mutation import FUZZ, clean, mutated
 
 _MYBOT = find_package("bingda_tutorials") / "urdf" / "mybot.xacro"
 URDF_TEXT = robot_description(_MYBOT)
 XACRO_TEXT = _MYBOT.read_text()
-WORLD_TEXT = (
-    Path(load_world.__code__.co_filename).parents[1] / "worlds" / "maze.world"
-).read_text()
+WORLD_TEXT = (BUNDLED_WORLDS_DIR / "maze.world").read_text()
 _NAV = find_package("robot_navigation")
 LAUNCH_TEXT = (_NAV / "launch" / "navigation_stack.launch").read_text()
 RVIZ_TEXT = (_NAV / "rviz" / "navigation.rviz").read_text()

@@ -1,4 +1,4 @@
-"""``roverlab map`` (run as ``python -m roverlab.maps``): info, bad input, server + save."""
+"""``roverlab map``: info, bad input, server + save."""
 
 from __future__ import annotations
 
@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
+from roverlab.cli.maps import app
 from roverlab.maps import MapError, save_map
-from roverlab.maps.cli import app
 from tests.helpers.procs import Proc
 
 runner = CliRunner()
@@ -20,7 +20,7 @@ runner = CliRunner()
 
 def _run(*args: str, cwd: Path, timeout: float = 60.0) -> subprocess.CompletedProcess[str]:
     return subprocess.run(
-        [sys.executable, "-m", "roverlab.maps", *args],
+        [sys.executable, "-m", "roverlab.cli", "map", *args],
         capture_output=True,
         text=True,
         timeout=timeout,
@@ -81,7 +81,7 @@ def test_help_names_the_command() -> None:
 def test_server_and_save_in_two_processes(daemon: str, office: Path, tmp_path: Path) -> None:
     out_dir = tmp_path / "out"
     out_dir.mkdir()
-    server = Proc([sys.executable, "-m", "roverlab.maps", "server", str(office)])
+    server = Proc([sys.executable, "-m", "roverlab.cli", "map", "server", str(office)])
     try:
         line = server.wait_line(lambda s: s.startswith("map_server:"), timeout=60)
         assert "publishing a 60 X 40 map @ 0.050 m/cell" in line and "/map" in line

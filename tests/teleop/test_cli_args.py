@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
+from roverlab.cli.teleop import main, parse_ros_args
 from roverlab.errors import RoverlabError
-from roverlab.teleop.cli import main, parse_ros_args
 from roverlab.teleop.node import MbotTeleopNode
 
 

@@ -1,4 +1,4 @@
-"""``python -m roverlab.teleop`` through a real pty: keys in, Twists out, terminal restored.
+"""``python -m roverlab.cli teleop`` through a real pty: keys in, Twists out, terminal restored.
 
 The teleop process joins the session's isolated daemon; a receiver in this process
 subscribes to ``/cmd_vel`` over Zenoh, as a simulator in another process would.
@@ -66,13 +66,13 @@ class Receiver:
 
 
 class PtyTeleop:
-    """``python -m roverlab.teleop ARGS`` with a pseudo-terminal as stdin and stdout."""
+    """``python -m roverlab.cli teleop ARGS`` with a pseudo-terminal as stdin and stdout."""
 
     def __init__(self, *args: str) -> None:
         self.master, self.slave = os.openpty()
         self.settings_before = termios.tcgetattr(self.slave)
         self.proc = subprocess.Popen(
-            [sys.executable, "-m", "roverlab.teleop", *args],
+            [sys.executable, "-m", "roverlab.cli", "teleop", *args],
             stdin=self.slave,
             stdout=self.slave,
             stderr=subprocess.PIPE,
@@ -281,7 +281,7 @@ def test_remap_reaches_the_other_topic(daemon: str, start_teleop: Callable[..., 
 
 def _run(*args: str, stdin: Any = subprocess.DEVNULL) -> subprocess.CompletedProcess[str]:
     return subprocess.run(
-        [sys.executable, "-m", "roverlab.teleop", *args],
+        [sys.executable, "-m", "roverlab.cli", "teleop", *args],
         stdin=stdin,
         capture_output=True,
         text=True,

@@ -24,7 +24,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-import roverlab.robots
+import roverlab.packages
 from roverlab.core import Context, Time
 from roverlab.description.node import JointStatePublisher, RobotStatePublisher
 from roverlab.geometry import Transform3, quat_from_rpy
@@ -38,7 +38,7 @@ from roverlab.viz.config import DisplayConfig, load_rviz
 CHROMIUM = Path("/usr/bin/chromium")
 CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--no-first-run"]
 VIEWPORT = {"width": 1400, "height": 860}
-MYCAR = Path(roverlab.robots.__file__).parent / "mycar"
+MYCAR = Path(roverlab.packages.__file__).parent / "mycar"
 URDLEE = Path(__file__).parent / "fixtures" / "urdlee"
 
 playwright_sync = pytest.importorskip("playwright.sync_api", reason="playwright not installed")

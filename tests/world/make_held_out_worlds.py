@@ -19,7 +19,7 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path
 
-DEFAULT_OUT = Path(__file__).resolve().parents[2] / "src/roverlab/worlds"
+DEFAULT_OUT = Path(__file__).resolve().parents[2] / "src/roverlab/world/bundled"
 WALL_T = 0.15
 WALL_H = 2.5
 

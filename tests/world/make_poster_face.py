@@ -1,6 +1,6 @@
 """Regenerate the face poster texture of the bundled office world.
 
-The checked-in ``src/roverlab/worlds/models/poster_face/materials/textures/face.png`` is
+The checked-in ``src/roverlab/world/bundled/models/poster_face/materials/textures/face.png`` is
 the face of ``skimage.data.astronaut()`` (Eileen Collins, a NASA photograph in the public
 domain) cropped to 200 x 200 pixels. Run this script to rebuild it::
 
@@ -22,7 +22,7 @@ from PIL import Image, ImageDraw, ImageFilter
 
 DEFAULT_OUT = (
     Path(__file__).resolve().parents[2]
-    / "src/roverlab/worlds/models/poster_face/materials/textures/face.png"
+    / "src/roverlab/world/bundled/models/poster_face/materials/textures/face.png"
 )
 CROP = (120, 0, 320, 200)  # left, top, right, bottom in the 512 x 512 astronaut image
 

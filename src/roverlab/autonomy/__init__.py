@@ -6,6 +6,6 @@
   time, contacts with the world;
 * :mod:`.explore_run`: one exploration episode, headless (``roverlab explore``);
 
-The algorithms stay in :mod:`roverlab.navigation` and :mod:`roverlab.mapping`; this package
+The algorithms stay in :mod:`roverlab.navigation` and :mod:`roverlab.slam`; this package
 only wires nodes and measures.
 """

@@ -26,7 +26,7 @@ from roverlab.core import Context
 from roverlab.maps import save_map
 from roverlab.maps.plot import write_map_png
 from roverlab.sim.node import SpawnPose
-from roverlab.slam.mapquality import MapQualityError, evaluate_map, grid_from_msg, ground_truth
+from roverlab.slam.data.mapquality import MapQualityError, evaluate_map, grid_from_msg, ground_truth
 
 __all__ = ["ExploreResult", "run_explore", "write_explore_outputs"]
 

@@ -43,7 +43,7 @@ from roverlab.msgs import Twist
 from roverlab.navigation.move_base.node import MoveBase
 from roverlab.navigation.patrol import load_places
 from roverlab.navigation.patrol_client import Patroller
-from roverlab.slam.mapquality import MapQualityError, evaluate_map, grid_from_msg, ground_truth
+from roverlab.slam.data.mapquality import MapQualityError, evaluate_map, grid_from_msg, ground_truth
 from roverlab.tf import TransformException
 
 __all__ = ["DemoReport", "DemoStory", "demo_world"]

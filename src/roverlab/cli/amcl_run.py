@@ -35,8 +35,8 @@ from roverlab.localization.amcl import (
     map_for_amcl,
 )
 from roverlab.maps import OccupancyMap, load_map, occupancy_to_image
-from roverlab.slam.reversing import ReversingRepair
-from roverlab.slam.trajectory import read_tum, write_tum
+from roverlab.slam.data.reversing import ReversingRepair
+from roverlab.slam.data.trajectory import read_tum, write_tum
 
 __all__ = ["app", "run"]
 

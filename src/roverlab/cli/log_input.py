@@ -20,8 +20,8 @@ from rich.progress import (
 )
 
 from roverlab.errors import RoverlabError
-from roverlab.slam.logs import LaserLog, ScanRecord, load_log
-from roverlab.slam.reversing import ReversingRepair
+from roverlab.slam.data.logs import LaserLog, ScanRecord, load_log
+from roverlab.slam.data.reversing import ReversingRepair
 
 __all__ = [
     "BaseFrameOption",

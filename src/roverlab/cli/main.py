@@ -7,7 +7,6 @@ from typing import Annotated
 
 import typer
 
-from roverlab.bag import cli as bag_cli
 from roverlab.cli import (
     action,
     amcl_run,
@@ -26,14 +25,15 @@ from roverlab.cli import (
     tf,
     topic,
 )
+from roverlab.cli import bag as bag_cli
+from roverlab.cli import description as urdf_cli
+from roverlab.cli import foxglove as foxglove_cli
+from roverlab.cli import maps as map_cli
+from roverlab.cli import slam as slam_cli
+from roverlab.cli import teleop as teleop_cli
+from roverlab.cli import viz as viz_cli
 from roverlab.cli.common import NetworkOptions
-from roverlab.description import cli as urdf_cli
 from roverlab.errors import RoverlabError
-from roverlab.foxglove import cli as foxglove_cli
-from roverlab.maps import cli as map_cli
-from roverlab.slam import cli as slam_cli
-from roverlab.teleop import cli as teleop_cli
-from roverlab.viz import cli as viz_cli
 
 app = typer.Typer(
     name="roverlab",

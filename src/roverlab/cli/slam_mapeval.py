@@ -10,8 +10,8 @@ import typer
 
 from roverlab.geometry import SE2
 from roverlab.maps import load_map
-from roverlab.slam.errors import SlamError
-from roverlab.slam.mapquality import (
+from roverlab.slam.data.errors import SlamError
+from roverlab.slam.data.mapquality import (
     OccupancyMapLike,
     evaluate_map,
     ground_truth,

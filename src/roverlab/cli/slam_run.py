@@ -23,15 +23,15 @@ from roverlab.cli.log_input import (
     progress,
     read_log,
 )
-from roverlab.mapping.gmapping import GMapping, GMappingParams
-from roverlab.mapping.graph import GraphParams, GraphSLAM
-from roverlab.mapping.graph.params import NODE_PARAMETERS
-from roverlab.mapping.hector import HectorParams, HectorSLAM
 from roverlab.maps import save_map
 from roverlab.maps.plot import write_map_png
-from roverlab.slam.errors import SlamError
-from roverlab.slam.logs import LaserLog
-from roverlab.slam.trajectory import Trajectory, write_tum
+from roverlab.slam.data.errors import SlamError
+from roverlab.slam.data.logs import LaserLog
+from roverlab.slam.data.trajectory import Trajectory, write_tum
+from roverlab.slam.gmapping import GMapping, GMappingParams
+from roverlab.slam.graph import GraphParams, GraphSLAM
+from roverlab.slam.graph.params import NODE_PARAMETERS
+from roverlab.slam.hector import HectorParams, HectorSLAM
 
 METHODS = ("hector", "gmapping", "graph")
 # map edge beyond the odometry's bounding box when hector's map is sized from the log: this

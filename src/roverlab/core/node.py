@@ -157,6 +157,11 @@ class Subscription:
         q.append(msg)
         self._ready.append((next(self._seq), self._take_ref))
 
+    @property
+    def pending(self) -> int:
+        """Messages waiting for the callback."""
+        return len(self._queue)
+
     def _take(self) -> None:
         if self._queue and self.active:
             self.received += 1

@@ -3,7 +3,7 @@
 The pieces, bottom up:
 
 * :mod:`.packages`: ``$(find pkg)`` / ``package://`` through ``ROVERLAB_PACKAGE_PATH``,
-  ``ROS_PACKAGE_PATH`` and the robots bundled in :mod:`roverlab.robots`;
+  ``ROS_PACKAGE_PATH`` and the robots bundled in :mod:`roverlab.packages`;
 * :mod:`.xacro_hook`: the ``xacro`` package with ``$(find)`` hooked to that path;
 * :mod:`.model` and :mod:`.gazebo`: frozen dataclasses for links, joints, sensors and
   plugins, and the tree math (root, chains, link poses for joint positions);

@@ -8,7 +8,7 @@ root that provides a name wins. The roots, in order:
 
 1. ``ROVERLAB_PACKAGE_PATH`` (``os.pathsep``-separated),
 2. ``ROS_PACKAGE_PATH``,
-3. the packages bundled with roverlab (:data:`roverlab.robots.BUNDLED_PACKAGES_DIR`),
+3. the packages bundled with roverlab (:data:`roverlab.packages.BUNDLED_PACKAGES_DIR`),
 4. extra folders given by the caller (``package_path=``).
 """
 
@@ -22,7 +22,7 @@ from typing import Final
 from urllib.parse import unquote, urlparse
 
 from roverlab.description.errors import DescriptionError, PackageNotFoundError
-from roverlab.robots import BUNDLED_PACKAGES_DIR
+from roverlab.packages import BUNDLED_PACKAGES_DIR
 
 __all__ = [
     "ENV_VARS",

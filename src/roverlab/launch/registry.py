@@ -23,14 +23,14 @@ from roverlab.launch.state import LaunchState, NodeFactory
 from roverlab.launch.xml import LaunchError, NodeSpec
 from roverlab.localization.amcl.node import AmclNode
 from roverlab.localization.fake_localization import FakeLocalization
-from roverlab.mapping.gmapping.node import SlamGMapping
-from roverlab.mapping.graph.node import SlamKarto, SlamToolbox
-from roverlab.mapping.hector.node import HectorMapping
 from roverlab.maps.node import MapSaver, MapServer
 from roverlab.msgs import classes as mc
 from roverlab.navigation.costmap.node import Costmap2DNode
 from roverlab.navigation.explore.node import Explore
 from roverlab.navigation.move_base.node import MoveBase
+from roverlab.slam.gmapping.node import SlamGMapping
+from roverlab.slam.graph.node import SlamKarto, SlamToolbox, SyncSlamToolbox
+from roverlab.slam.hector.node import HectorMapping
 from roverlab.viz.errors import DashboardError
 from roverlab.viz.joints import SLIDER_TOPIC
 from roverlab.viz.launcher import start_image_view, start_rviz
@@ -308,7 +308,7 @@ def _slam_node(make: Callable[..., Node]) -> NodeFactory:
 REGISTRY[("gmapping", "slam_gmapping")] = _slam_node(SlamGMapping)
 REGISTRY[("hector_mapping", "hector_mapping")] = _slam_node(HectorMapping)
 REGISTRY[("slam_toolbox", "async_slam_toolbox_node")] = _slam_node(SlamToolbox)
-REGISTRY[("slam_toolbox", "sync_slam_toolbox_node")] = _slam_node(SlamToolbox)
+REGISTRY[("slam_toolbox", "sync_slam_toolbox_node")] = _slam_node(SyncSlamToolbox)
 REGISTRY[("slam_karto", "slam_karto")] = _slam_node(SlamKarto)
 REGISTRY[("costmap_2d", "costmap_2d_node")] = _slam_node(Costmap2DNode)
 REGISTRY[("amcl", "amcl")] = _slam_node(AmclNode)

@@ -6,7 +6,7 @@
   rules (trinary, scale, raw, negate, alpha) and written byte for byte as map_saver does;
 * :mod:`.node`: the ``map_server`` and ``map_saver`` nodes (import them from
   ``roverlab.maps.node``: this package itself stays free of the runtime);
-* :mod:`.cli`: ``roverlab map server | save | info`` (also ``python -m roverlab.maps``).
+* ``roverlab map server | save | info`` is :mod:`roverlab.cli.maps`.
 
 Every error is a :class:`MapError` (a :class:`roverlab.errors.RoverlabError`).
 """

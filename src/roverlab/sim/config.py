@@ -12,7 +12,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from roverlab.geometry import Transform3
-from roverlab.sim.physics import DiffDriveParams
+from roverlab.sim.diff_drive import DiffDriveParams
 from roverlab.sim.sensors import CameraParams, ImuNoise, LidarParams
 
 __all__ = [

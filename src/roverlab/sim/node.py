@@ -1,6 +1,6 @@
 """The simulator node (what ``gazebo_ros`` + the robot's ``<gazebo>`` plugins are in ROS).
 
-Thin: it wires :mod:`roverlab.sim.physics`, :mod:`roverlab.sim.collision` and
+Thin: it wires :mod:`roverlab.sim.diff_drive`, :mod:`roverlab.sim.collision` and
 :mod:`roverlab.sim.sensors` to topics, TF and parameters. Every random draw comes from a
 generator spawned from the ``seed`` parameter, so a seeded run is reproducible.
 """
@@ -22,6 +22,7 @@ from roverlab.raycast import Scene
 from roverlab.raycast.camera import camera_intrinsics, depth_to_points
 from roverlab.sim.collision import Obstacles, inner_radius
 from roverlab.sim.config import CameraSensor, DepthSensor, ImuSensor, LidarSensor, RobotSimConfig
+from roverlab.sim.diff_drive import DiffDriveParams
 from roverlab.sim.dynamics import (
     S_AL,
     S_AR,
@@ -44,7 +45,6 @@ from roverlab.sim.dynamics import (
     advance,
     compiled_entry,
 )
-from roverlab.sim.physics import DiffDriveParams
 from roverlab.sim.sensors import CameraModel, ImuModel, LidarModel
 from roverlab.tf import TransformBroadcaster
 

@@ -33,7 +33,7 @@ from roverlab.sim.config import (
     LidarSensor,
     RobotSimConfig,
 )
-from roverlab.sim.physics import DiffDriveParams
+from roverlab.sim.diff_drive import DiffDriveParams
 from roverlab.sim.sensors import CameraParams, ImuNoise, LidarParams
 
 __all__ = ["sim_config_from_model"]

@@ -13,7 +13,7 @@ from typing import Any, Final, Protocol
 
 from roverlab.core.qos import QoSProfile
 from roverlab.core.time import Time
-from roverlab.tf.buffer import DEFAULT_AUTHORITY, BufferCore
+from roverlab.tf.buffer_core import DEFAULT_AUTHORITY, BufferCore
 from roverlab.tf.convert import TF_MESSAGE_TYPE, tf_message, transform_from_msg
 from roverlab.tf.errors import InvalidArgumentException
 

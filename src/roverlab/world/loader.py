@@ -14,7 +14,7 @@ from roverlab.world.yaml_world import read_yaml, world_from_dict
 
 __all__ = ["BUNDLED_WORLDS", "BUNDLED_WORLDS_DIR", "bundled_world_path", "load_world"]
 
-BUNDLED_WORLDS_DIR = Path(__file__).resolve().parent.parent / "worlds"
+BUNDLED_WORLDS_DIR = Path(__file__).resolve().parent / "bundled"
 
 #: Bundled worlds and what they hold; every one spawns robots at (0, 0, 0).
 BUNDLED_WORLDS: dict[str, str] = {

@@ -194,6 +194,17 @@ def open_session(options: ZenohOptions) -> tuple[zenoh.Session, list[str]]:
 def _connect_failure(options: ZenohOptions, answers: bool) -> str:
     """Why no ``connect`` endpoint took the session: nothing listening, or refused."""
     endpoints = ", ".join(options.connect)
+    if answers and all(ep.startswith("tls/") for ep in options.connect):
+        if options.tls_root_ca is None:
+            return (
+                f"{endpoints}: no TLS session: give --tls-root-ca, the CA that signed "
+                "that side's certificate"
+            )
+        also = ", or wrong --user/--password" if options.user is not None else ""
+        return (
+            f"{endpoints} refused the TLS session: its certificate is not signed by "
+            f"--tls-root-ca {options.tls_root_ca} or does not name that host{also}"
+        )
     if answers:
         auth = (
             "wrong --user/--password"

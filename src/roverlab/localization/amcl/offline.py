@@ -19,8 +19,8 @@ from roverlab.localization.amcl.errors import AmclMapError
 from roverlab.localization.amcl.field import AmclMap
 from roverlab.localization.amcl.params import AmclParams
 from roverlab.maps import OccupancyMap
-from roverlab.slam.logs import ScanRecord
-from roverlab.slam.trajectory import Trajectory
+from roverlab.slam.data.logs import ScanRecord
+from roverlab.slam.data.trajectory import Trajectory
 
 __all__ = ["AmclRun", "Snapshot", "localize_log", "map_for_amcl"]
 
@@ -82,7 +82,7 @@ class AmclRun:
 def localize_log(
     records: Iterable[ScanRecord], amcl: Amcl, *, snapshot_at: Sequence[int] = ()
 ) -> AmclRun:
-    """Run ``amcl`` over ``records`` (a :class:`~roverlab.slam.logs.LaserLog` or any
+    """Run ``amcl`` over ``records`` (a :class:`~roverlab.slam.data.logs.LaserLog` or any
     iterable of its records).
 
     Args:

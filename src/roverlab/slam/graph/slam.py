@@ -1,0 +1,795 @@
+"""Graph SLAM in the manner of slam_karto / slam_toolbox (Karto's ``Mapper``), plain arrays.
+
+Per scan (:meth:`GraphSLAM.process`):
+
+1. the beams within ``[min_laser_range, max_laser_range]`` (and the sensor's limits)
+   become points in the robot frame through the laser offset;
+2. the pose is predicted from the previous estimate and the odometry delta, and corrected
+   by Karto's correlative matcher (:mod:`roverlab.slam.graph.matcher`) against the
+   correlation grid of the *running buffer* (the last ``scan_buffer_size`` keyframes within
+   ``scan_buffer_maximum_scan_distance``), penalised for straying from the prediction;
+3. once the odometry moved ``minimum_travel_distance`` or turned ``minimum_travel_heading``
+   since the last keyframe, the scan becomes a keyframe, a vertex of the pose graph, with
+   Karto's edges (``MapperGraph::AddEdges``): to the previous keyframe, to the closest
+   keyframe of the running buffer, and to every *near chain* (older keyframes within
+   ``link_scan_maximum_distance``, reached through the graph) that it matches with a
+   response above ``link_match_minimum_response_fine``; its pose becomes the
+   information-weighted mean of those matches;
+4. loop closing (``MapperGraph::TryCloseLoop``): chains of at least
+   ``loop_match_minimum_chain_size`` consecutive keyframes within
+   ``loop_search_maximum_distance`` that are not reached through the graph within that
+   distance are matched coarsely (``loop_search_space_*``, whole chain, no penalty); a
+   match with response above ``loop_match_minimum_response_coarse`` and x/y variance
+   below ``loop_match_maximum_variance_coarse`` is matched again finely, and with a
+   response of at least ``loop_match_minimum_response_fine`` becomes an edge;
+5. after new loop edges the graph is optimised (:func:`roverlab.slam.data.pose_solver.optimize`,
+   sparse Gauss-Newton / Levenberg-Marquardt, warm-started). A consistency check guards
+   against a wrong closure: if afterwards a loop or near-chain edge is off by more than
+   ``loop_closure_max_residual``, the new closures are dropped and the poses restored.
+
+Unlike Karto, which drops the scans that are not keyframes, every scan gets a pose: it is
+matched against the running buffer like a keyframe and stored relative to its keyframe.
+The trajectory (:meth:`GraphSLAM.scan_poses`) places it relative to the optimised poses of
+the keyframes before and after it, blended by its position between them, so a correction
+of the graph is spread smoothly over the scans.
+
+The map (:meth:`GraphSLAM.occupancy`) is rendered from the optimised poses with the shared
+:class:`roverlab.maps.grid.CountGrid`, as Karto's ``OccupancyGrid``: hits over passes, cells
+passed by at most 2 beams unknown, occupied above a hit ratio of 0.1, beams beyond
+``max_laser_range`` clearing up to it.
+
+Poses are of the robot (base) frame in the map frame; the map frame starts on the odometry
+frame (the first scan's pose is its odometry pose), as in Karto.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+from typing import Any, NamedTuple
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import breadth_first_order
+
+from roverlab.geometry import SE2
+from roverlab.maps.grid import CountGrid
+from roverlab.slam.common import ScanLike
+from roverlab.slam.data.pose_solver import optimize
+from roverlab.slam.data.posegraph import PoseGraph, edge_errors
+from roverlab.slam.data.trajectory import Trajectory
+from roverlab.slam.graph.errors import GraphSlamInputError
+from roverlab.slam.graph.matcher import (
+    CorrelationGrid,
+    MatchResult,
+    Penalty,
+    block_size,
+    build_grid,
+    match_scan,
+    valid_points,
+)
+from roverlab.slam.graph.params import GraphParams
+
+__all__ = ["GraphMap", "GraphRun", "GraphSLAM", "ScanLike", "run_graph", "run_log"]
+
+FloatArray = NDArray[np.float64]
+
+#: Karto's ``OccupancyGrid`` defaults: minimum passes for a known cell, and hit ratio.
+MIN_PASS_THROUGH = 2
+OCCUPANCY_THRESHOLD = 0.1
+#: Largest number of solver iterations after a loop closure (warm-started).
+_OPT_ITERATIONS = 20
+_TWO_PI = 2.0 * math.pi
+
+
+@dataclass(frozen=True, eq=False)
+class GraphMap:
+    """The occupancy map (``nav_msgs/OccupancyGrid`` conventions).
+
+    Attributes:
+        data: ``(H, W)`` int8, row 0 at the lowest y; -1 unknown, 0 free, 100 occupied.
+        resolution: cell size (m).
+        origin: world ``(x, y)`` of the outer corner of cell ``(0, 0)`` (m).
+    """
+
+    data: NDArray[np.int8]
+    resolution: float
+    origin: tuple[float, float]
+
+    @property
+    def origin_xy(self) -> tuple[float, float]:
+        """Alias of :attr:`origin` (the name :class:`roverlab.maps.grid` uses)."""
+        return self.origin
+
+
+class GraphRun(NamedTuple):
+    """Result of a batch run: unpacks as ``poses, map, trajectory``.
+
+    Attributes:
+        poses: ``(N, 3)`` final robot pose per scan, map frame.
+        map: the map rendered from the optimised poses.
+        trajectory: the poses with the scans' timestamps (and their exact texts).
+    """
+
+    poses: FloatArray
+    map: GraphMap
+    trajectory: Trajectory
+
+
+@dataclass(frozen=True, eq=False)
+class _Scan:
+    """What a keyframe keeps to be matched against and rendered."""
+
+    points: FloatArray  # (N, 2) robot frame, usable for matching
+    ranges: NDArray[np.float32]
+    angles: FloatArray
+    range_min: float
+    range_max: float
+    laser_offset: FloatArray  # (3,)
+
+
+# ------------------------------------------------------------------------------ pose helpers
+
+
+def _wrap(a: Any) -> Any:
+    return (np.asarray(a) + math.pi) % _TWO_PI - math.pi
+
+
+def _compose(a: FloatArray, b: FloatArray) -> FloatArray:
+    """``a * b`` row-wise for ``(..., 3)`` poses."""
+    a = np.asarray(a, dtype=np.float64)
+    b = np.asarray(b, dtype=np.float64)
+    c, s = np.cos(a[..., 2]), np.sin(a[..., 2])
+    return np.stack(
+        [
+            a[..., 0] + c * b[..., 0] - s * b[..., 1],
+            a[..., 1] + s * b[..., 0] + c * b[..., 1],
+            _wrap(a[..., 2] + b[..., 2]),
+        ],
+        axis=-1,
+    )
+
+
+def _relative(a: FloatArray, b: FloatArray) -> FloatArray:
+    """``a^-1 * b`` row-wise."""
+    a = np.asarray(a, dtype=np.float64)
+    b = np.asarray(b, dtype=np.float64)
+    c, s = np.cos(a[..., 2]), np.sin(a[..., 2])
+    dx, dy = b[..., 0] - a[..., 0], b[..., 1] - a[..., 1]
+    return np.stack([c * dx + s * dy, -s * dx + c * dy, _wrap(b[..., 2] - a[..., 2])], axis=-1)
+
+
+def _inverse(a: FloatArray) -> FloatArray:
+    return _relative(a, np.zeros_like(a))
+
+
+def _transform_points(pose: FloatArray, pts: FloatArray) -> FloatArray:
+    c, s = math.cos(pose[2]), math.sin(pose[2])
+    out = np.empty_like(pts)
+    out[:, 0] = pose[0] + c * pts[:, 0] - s * pts[:, 1]
+    out[:, 1] = pose[1] + s * pts[:, 0] + c * pts[:, 1]
+    return out
+
+
+def _pose_array(pose: ArrayLike | SE2, what: str) -> FloatArray:
+    arr = pose.as_array() if isinstance(pose, SE2) else np.asarray(pose, dtype=np.float64)
+    arr = np.asarray(arr, dtype=np.float64).reshape(-1)
+    if arr.shape != (3,) or not np.all(np.isfinite(arr)):
+        raise GraphSlamInputError(f"{what} must be 3 finite numbers (x, y, theta), got {arr}")
+    return arr
+
+
+def _runs(mask: NDArray[np.bool_]) -> list[tuple[int, int]]:
+    """``[start, stop)`` of every maximal run of True."""
+    m = np.concatenate([[False], mask, [False]]).astype(np.int8)
+    d = np.diff(m)
+    starts = np.flatnonzero(d == 1)
+    stops = np.flatnonzero(d == -1)
+    return list(zip(starts.tolist(), stops.tolist(), strict=True))
+
+
+def _information(cov: FloatArray, heading: float) -> FloatArray:
+    """Information of an edge whose target was matched with world covariance ``cov``:
+    rotated into the target's frame (the frame of the g2o error)."""
+    c, s = math.cos(heading), math.sin(heading)
+    r = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    local = r.T @ cov @ r
+    local = 0.5 * (local + local.T) + np.eye(3) * 1e-12
+    info = np.linalg.inv(local)
+    return np.asarray(0.5 * (info + info.T), dtype=np.float64)
+
+
+# ------------------------------------------------------------------------------ the mapper
+
+
+class GraphSLAM:
+    """Karto / slam_toolbox graph SLAM on plain arrays (no node, no clock, no TF).
+
+    Args:
+        params: algorithm parameters (ROS names, slam_toolbox defaults).
+        rng: accepted for the common SLAM interface; the method draws no random numbers
+            (it is deterministic), so it is unused.
+        laser_offset: default laser pose in the robot frame (``base_frame -> laser``).
+    """
+
+    def __init__(
+        self,
+        params: GraphParams | None = None,
+        rng: np.random.Generator | None = None,
+        *,
+        laser_offset: SE2 | None = None,
+    ) -> None:
+        self.params = params if params is not None else GraphParams()
+        self.rng = rng
+        self.laser_offset = laser_offset if laser_offset is not None else SE2()
+        p = self.params
+        self._seq_n = int(
+            math.floor(0.5 * p.correlation_search_space_dimension
+                       / p.correlation_search_space_resolution + 1e-9)
+        )  # fmt: skip
+        self._seq_block = block_size(self._seq_n)
+        self._loop_block = block_size(
+            int(math.floor(0.5 * p.loop_search_space_dimension / p.loop_search_space_resolution))
+        )
+        self._penalty = Penalty(
+            p.distance_variance_penalty,
+            p.angle_variance_penalty,
+            p.minimum_distance_penalty,
+            p.minimum_angle_penalty,
+        )
+        self.reset()
+
+    # ---------------------------------------------------------------- state
+    def reset(self) -> None:
+        """Forget everything (an empty graph, no scans)."""
+        self._kf_pose = np.zeros((0, 3))
+        self._kf_odom = np.zeros((0, 3))
+        self._kf_scan_index: list[int] = []
+        self._kf_scans: list[_Scan] = []
+        self._kf_prev_rel = np.zeros((0, 3))  # pose of keyframe k in keyframe k-1 at creation
+        self._e_from: list[int] = []
+        self._e_to: list[int] = []
+        self._e_meas: list[FloatArray] = []
+        self._e_info: list[FloatArray] = []
+        self._e_kind: list[str] = []  # "sequential", "near", "loop"
+        self._buffer: list[int] = []
+        self._grid: CorrelationGrid | None = None
+        self._scan_ref: list[int] = []
+        self._scan_rel: list[FloatArray] = []
+        self._all_scans: list[_Scan] = []
+        self._last_pose: FloatArray | None = None
+        self._last_odom: FloatArray | None = None
+        self.loop_closures = 0
+        self.rejected_loop_closures = 0
+        self.optimisations = 0
+        self.last_response = 0.0
+
+    @property
+    def num_keyframes(self) -> int:
+        """Vertices of the pose graph."""
+        return int(self._kf_pose.shape[0])
+
+    @property
+    def scans_processed(self) -> int:
+        """Scans given to :meth:`process` since the last reset."""
+        return len(self._scan_ref)
+
+    @property
+    def pose(self) -> SE2:
+        """The latest robot pose estimate in the map frame."""
+        if self._last_pose is None:
+            return SE2()
+        return SE2(*(float(v) for v in self._last_pose))
+
+    def map_to_odom(self) -> SE2:
+        """The ``map -> odom`` transform: latest pose times the inverse latest odometry."""
+        if self._last_pose is None or self._last_odom is None:
+            return SE2()
+        t = _compose(self._last_pose, _inverse(self._last_odom))
+        return SE2(float(t[0]), float(t[1]), float(t[2]))
+
+    # ---------------------------------------------------------------- scans
+    def scan_points(
+        self,
+        ranges: ArrayLike,
+        angles: ArrayLike,
+        *,
+        range_min: float = 0.0,
+        range_max: float = math.inf,
+        laser_offset: SE2 | None = None,
+    ) -> FloatArray:
+        """The matchable endpoints of a scan, ``(N, 2)`` in the robot frame (m).
+
+        Raises:
+            GraphSlamInputError: mismatched shapes or non-finite angles.
+        """
+        r = np.asarray(ranges, dtype=np.float64).reshape(-1)
+        a = np.asarray(angles, dtype=np.float64).reshape(-1)
+        if r.shape != a.shape:
+            raise GraphSlamInputError(f"{r.size} ranges but {a.size} angles")
+        if not np.all(np.isfinite(a)):
+            raise GraphSlamInputError("beam angles must be finite")
+        p = self.params
+        with np.errstate(invalid="ignore"):
+            keep = (
+                np.isfinite(r)
+                & (r > range_min)
+                & (r < range_max)
+                & (r >= p.min_laser_range)
+                & (r <= p.max_laser_range)
+            )
+        off = self.laser_offset if laser_offset is None else laser_offset
+        ang = a[keep] + off.theta
+        rr = r[keep]
+        return np.stack([off.x + rr * np.cos(ang), off.y + rr * np.sin(ang)], axis=1)
+
+    def process(
+        self,
+        ranges: ArrayLike,
+        angles: ArrayLike,
+        odom_pose: ArrayLike | SE2,
+        timestamp: float | None = None,
+        *,
+        range_min: float = 0.0,
+        range_max: float = math.inf,
+        laser_offset: SE2 | None = None,
+    ) -> SE2:
+        """Process one scan; return the robot pose in the map frame.
+
+        Cheap unless the scan becomes a keyframe (one branch-and-bound match against the
+        running buffer's grid).
+
+        Args:
+            ranges: ``(N,)`` ranges (m); non-finite ones are dropped.
+            angles: ``(N,)`` beam angles in the laser frame (rad).
+            odom_pose: robot pose ``(x, y, theta)`` in the odometry frame at the scan.
+            timestamp: scan time (s); only checked (it must be finite when given).
+            range_min: the sensor's minimum range (m).
+            range_max: the sensor's maximum range (m); readings at or beyond it are no
+                returns.
+            laser_offset: this scan's laser pose in the robot frame (default: the
+                constructor's).
+
+        Raises:
+            GraphSlamInputError: bad shapes, non-finite angles, odometry or timestamp.
+        """
+        if timestamp is not None and not math.isfinite(float(timestamp)):
+            raise GraphSlamInputError(f"timestamp must be finite, got {timestamp}")
+        odom = _pose_array(odom_pose, "odom_pose")
+        off = self.laser_offset if laser_offset is None else laser_offset
+        pts = self.scan_points(
+            ranges, angles, range_min=range_min, range_max=range_max, laser_offset=off
+        )
+        scan = _Scan(
+            points=pts,
+            ranges=np.asarray(ranges, dtype=np.float32).reshape(-1).copy(),
+            angles=np.asarray(angles, dtype=np.float64).reshape(-1).copy(),
+            range_min=float(range_min),
+            range_max=float(range_max),
+            laser_offset=off.as_array(),
+        )
+        p = self.params
+        if self.params.map_scans == "all":
+            self._all_scans.append(scan)
+        if self._last_pose is None or self._last_odom is None:
+            pose = odom.copy()
+            self._add_keyframe(pose, odom, scan, None)
+            pose = self._kf_pose[-1].copy()
+        else:
+            pred = _compose(self._last_pose, _relative(self._last_odom, odom))
+            last_kf = self.num_keyframes - 1
+            d_odom = _relative(self._kf_odom[last_kf], odom)
+            keyframe = (
+                math.hypot(d_odom[0], d_odom[1]) >= p.minimum_travel_distance
+                or abs(d_odom[2]) >= p.minimum_travel_heading
+            )
+            result: MatchResult | None = None
+            if p.use_scan_matching and pts.shape[0] >= 3 and self._grid is not None:
+                result = self._match_sequential(self._grid, pts, pred, penalise=True, cov=keyframe)
+                pose = result.pose
+                self.last_response = result.response
+            else:
+                pose = pred
+            if keyframe:
+                cov = result.covariance if result is not None else None
+                self._add_keyframe(pose, odom, scan, cov)
+                pose = self._kf_pose[-1].copy()
+        k = self.num_keyframes - 1
+        self._scan_ref.append(k)
+        self._scan_rel.append(_relative(self._kf_pose[k], pose))
+        self._last_pose = pose
+        self._last_odom = odom
+        return SE2(float(pose[0]), float(pose[1]), float(pose[2]))
+
+    # ---------------------------------------------------------------- matching
+    def _seq_grid(
+        self, frames: list[int], center: FloatArray, viewpoint: FloatArray
+    ) -> CorrelationGrid:
+        p = self.params
+        reach = (
+            p.max_laser_range + 0.5 * p.correlation_search_space_dimension
+            + p.minimum_travel_distance + 1.0
+        )  # fmt: skip
+        return build_grid(
+            self._world_points(frames, viewpoint),
+            resolution=p.correlation_search_space_resolution,
+            smear_deviation=p.correlation_search_space_smear_deviation,
+            block=self._seq_block,
+            bounds=(center[0] - reach, center[1] - reach, center[0] + reach, center[1] + reach),
+        )
+
+    def _world_points(self, frames: list[int], viewpoint: FloatArray) -> FloatArray:
+        chunks = [
+            valid_points(
+                _transform_points(self._kf_pose[i], self._kf_scans[i].points),
+                (float(viewpoint[0]), float(viewpoint[1])),
+            )
+            for i in frames
+        ]
+        return np.concatenate(chunks) if chunks else np.zeros((0, 2))
+
+    def _match_sequential(
+        self, grid: CorrelationGrid, pts: FloatArray, pred: FloatArray, *, penalise: bool, cov: bool
+    ) -> MatchResult:
+        p = self.params
+        return match_scan(
+            grid,
+            pts,
+            pred,
+            search_dimension=p.correlation_search_space_dimension,
+            coarse_angle_offset=p.coarse_search_angle_offset,
+            coarse_angle_resolution=p.coarse_angle_resolution,
+            fine_angle_offset=p.fine_search_angle_offset,
+            penalty=self._penalty if penalise else None,
+            refine_angle=True,
+            subcell=p.scan_match_refinement,
+            covariance=cov,
+            response_expansion=p.use_response_expansion,
+        )
+
+    def _laser_position(self, k: int) -> FloatArray:
+        return _compose(self._kf_pose[k], self._kf_scans[k].laser_offset)[:2]
+
+    # ---------------------------------------------------------------- graph building
+    def _add_edge(self, i: int, j: int, mean_j: FloatArray, cov: FloatArray, kind: str) -> None:
+        if i == j:
+            return
+        for e in range(len(self._e_from)):  # edges of j are few and at the end
+            if self._e_to[-1 - e] != j:
+                break
+            if self._e_from[-1 - e] == i:
+                return  # Karto keeps the first edge between two scans
+        self._e_from.append(i)
+        self._e_to.append(j)
+        self._e_meas.append(_relative(self._kf_pose[i], mean_j))
+        self._e_info.append(_information(cov, float(mean_j[2])))
+        self._e_kind.append(kind)
+
+    def _closest(self, frames: list[int] | NDArray[np.intp], pose: FloatArray) -> int:
+        idx = np.asarray(frames, dtype=np.intp)
+        d = np.hypot(self._kf_pose[idx, 0] - pose[0], self._kf_pose[idx, 1] - pose[1])
+        return int(idx[int(np.argmin(d))])
+
+    def _add_keyframe(
+        self, pose: FloatArray, odom: FloatArray, scan: _Scan, cov: FloatArray | None
+    ) -> None:
+        p = self.params
+        k = self.num_keyframes
+        prev_rel = np.zeros(3) if k == 0 else _relative(self._kf_pose[k - 1], pose)
+        self._kf_pose = np.vstack([self._kf_pose, pose[None, :]])
+        self._kf_odom = np.vstack([self._kf_odom, odom[None, :]])
+        self._kf_scans.append(scan)
+        self._kf_scan_index.append(len(self._scan_ref))
+        self._kf_prev_rel = np.vstack([self._kf_prev_rel, prev_rel[None, :]])
+        if k > 0:
+            if cov is None:
+                cov = np.diag([0.25, 0.25, 0.1])  # no match: a loose odometry link
+            means = [pose.copy()]
+            covs = [cov]
+            self._add_edge(k - 1, k, pose, cov, "sequential")
+            if self._buffer:
+                self._add_edge(self._closest(self._buffer, pose), k, pose, cov, "sequential")
+            if p.use_scan_matching and scan.points.shape[0] >= 3:
+                for mean, c in self._link_near_chains(k):
+                    means.append(mean)
+                    covs.append(c)
+            if len(means) > 1:
+                self._kf_pose[k] = _weighted_mean(means, covs)
+                self._kf_prev_rel[k] = _relative(self._kf_pose[k - 1], self._kf_pose[k])
+        self._buffer.append(k)
+        while len(self._buffer) > p.scan_buffer_size:
+            self._buffer.pop(0)
+        while len(self._buffer) > 1:
+            f = self._kf_pose[self._buffer[0], :2] - self._kf_pose[self._buffer[-1], :2]
+            if float(f @ f) > p.scan_buffer_maximum_scan_distance**2 - 1e-9:
+                self._buffer.pop(0)
+            else:
+                break
+        if k > 0 and p.do_loop_closing and p.use_scan_matching and scan.points.shape[0] >= 3:
+            self._try_close_loop(k)
+        self._grid = self._seq_grid(self._buffer, self._kf_pose[k], self._laser_position(k))
+
+    def _near_linked(self, k: int, distance: float) -> NDArray[np.bool_]:
+        """Karto's ``FindNearLinkedScans``: keyframes reached from ``k`` through the graph,
+        visiting only keyframes within ``distance`` of ``k``."""
+        n = self.num_keyframes
+        d = self._kf_pose[:, :2] - self._kf_pose[k, :2]
+        within = np.einsum("ij,ij->i", d, d) < distance * distance + 1e-9
+        out = np.zeros(n, dtype=bool)
+        fr = np.asarray(self._e_from, dtype=np.intp)
+        to = np.asarray(self._e_to, dtype=np.intp)
+        ok = within[fr] & within[to]
+        sub = np.flatnonzero(within)
+        index = np.full(n, -1, dtype=np.intp)
+        index[sub] = np.arange(sub.size)
+        adj = coo_matrix(
+            (np.ones(int(ok.sum())), (index[fr[ok]], index[to[ok]])), shape=(sub.size, sub.size)
+        ).tocsr()
+        reached = breadth_first_order(adj, int(index[k]), directed=False, return_predecessors=False)
+        out[sub[np.asarray(reached, dtype=np.intp)]] = True
+        return out
+
+    def _chain_grid_match(
+        self, k: int, chain: list[int], start: FloatArray, *, cov: bool
+    ) -> MatchResult:
+        grid = self._seq_grid(chain, start, self._laser_position(k))
+        return self._match_sequential(
+            grid, self._kf_scans[k].points, start, penalise=False, cov=cov
+        )
+
+    def _link_near_chains(self, k: int) -> list[tuple[FloatArray, FloatArray]]:
+        """Karto's ``LinkNearChains``; returns the accepted matches (mean, covariance)."""
+        p = self.params
+        near = self._near_linked(k, p.link_scan_maximum_distance)
+        d = self._kf_pose[:, :2] - self._kf_pose[k, :2]
+        within = np.einsum("ij,ij->i", d, d) < p.link_scan_maximum_distance**2 + 1e-9
+        within[k] = True
+        out: list[tuple[FloatArray, FloatArray]] = []
+        for a, b in _runs(within):
+            if b > k:  # the chain holds the new keyframe itself: invalid
+                continue
+            if b - a < p.loop_match_minimum_chain_size or not near[a:b].any():
+                continue
+            chain = list(range(a, b))
+            res = self._chain_grid_match(k, chain, self._kf_pose[k], cov=True)
+            if res.response > p.link_match_minimum_response_fine - 1e-9:
+                self._add_edge(self._closest(chain, res.pose), k, res.pose, res.covariance, "near")
+                out.append((res.pose, res.covariance))
+        return out
+
+    def _loop_chains(self, k: int) -> list[list[int]]:
+        """Karto's ``FindPossibleLoopClosure``, all chains at once."""
+        p = self.params
+        dist = p.loop_search_maximum_distance
+        near = self._near_linked(k, dist)[:k]
+        d = self._kf_pose[:k, :2] - self._kf_pose[k, :2]
+        within = np.einsum("ij,ij->i", d, d) < dist * dist + 1e-9
+        cand = within & ~near
+        chains = []
+        for a, b in _runs(cand):
+            # a linked scan right after the run resets Karto's chain
+            if b < k and near[b] and within[b]:
+                continue
+            if b - a >= p.loop_match_minimum_chain_size:
+                chains.append(list(range(a, b)))
+        return chains
+
+    def _try_close_loop(self, k: int) -> None:
+        """Karto's ``TryCloseLoop`` plus an optimisation and a consistency check."""
+        p = self.params
+        added = 0
+        backup = self._kf_pose.copy()
+        n_edges = len(self._e_from)
+        for chain in self._loop_chains(k):
+            viewpoint = self._laser_position(k)
+            coarse_grid = build_grid(
+                self._world_points(chain, viewpoint),
+                resolution=p.loop_search_space_resolution,
+                smear_deviation=p.loop_search_space_smear_deviation,
+                block=self._loop_block,
+            )
+            coarse = match_scan(
+                coarse_grid,
+                self._kf_scans[k].points,
+                self._kf_pose[k],
+                search_dimension=p.loop_search_space_dimension,
+                coarse_angle_offset=p.coarse_search_angle_offset,
+                coarse_angle_resolution=p.coarse_angle_resolution,
+                fine_angle_offset=p.fine_search_angle_offset,
+                penalty=None,
+                refine_angle=False,
+                subcell=False,
+                covariance=True,
+                response_expansion=False,
+            )
+            if not (
+                coarse.response > p.loop_match_minimum_response_coarse
+                and coarse.covariance[0, 0] < p.loop_match_maximum_variance_coarse
+                and coarse.covariance[1, 1] < p.loop_match_maximum_variance_coarse
+            ):
+                continue
+            fine = self._chain_grid_match(k, chain, coarse.pose, cov=True)
+            if fine.response < p.loop_match_minimum_response_fine:
+                continue
+            self._kf_pose[k] = fine.pose
+            self._add_edge(self._closest(chain, fine.pose), k, fine.pose, fine.covariance, "loop")
+            added += 1
+        if not added:
+            return
+        if self._optimise_checked(n_edges):
+            self.loop_closures += added
+        else:
+            self.rejected_loop_closures += added
+            del self._e_from[n_edges:], self._e_to[n_edges:], self._e_meas[n_edges:]
+            del self._e_info[n_edges:], self._e_kind[n_edges:]
+            self._kf_pose = backup
+
+    def _optimise_checked(self, first_new: int) -> bool:
+        """Optimise; False (poses untouched) if a closure edge ends up inconsistent."""
+        graph = self.graph()
+        poses, _ = optimize(graph, max_iterations=_OPT_ITERATIONS)
+        self.optimisations += 1
+        limit = self.params.loop_closure_max_residual
+        if limit > 0.0:
+            err = edge_errors(graph, poses)
+            kinds = np.asarray(self._e_kind)
+            check = kinds != "sequential"
+            if np.any(np.hypot(err[check, 0], err[check, 1]) > limit):
+                return False
+        self._kf_pose = np.asarray(poses, dtype=np.float64).copy()
+        return True
+
+    def optimise(self) -> None:
+        """Optimise the whole graph now (no consistency check)."""
+        if self.num_keyframes > 1 and self._e_from:
+            poses, _ = optimize(self.graph(), max_iterations=_OPT_ITERATIONS)
+            self.optimisations += 1
+            self._kf_pose = np.asarray(poses, dtype=np.float64).copy()
+            if self._last_pose is not None:
+                k = self._scan_ref[-1]
+                self._last_pose = _compose(self._kf_pose[k], self._scan_rel[-1])
+
+    # ---------------------------------------------------------------- outputs
+    def graph(self) -> PoseGraph:
+        """The pose graph of the keyframes (vertex ``k`` = keyframe ``k``, first fixed),
+        at the current estimates; ``roverlab.slam.data.write_g2o`` saves it."""
+        k = self.num_keyframes
+        if k == 0:
+            raise GraphSlamInputError("no scan processed yet: the graph is empty")
+        e = len(self._e_from)
+        return PoseGraph(
+            ids=np.arange(k, dtype=np.int64),
+            poses=self._kf_pose.copy(),
+            edge_from=np.asarray(self._e_from, dtype=np.intp),
+            edge_to=np.asarray(self._e_to, dtype=np.intp),
+            measurements=np.asarray(self._e_meas, dtype=np.float64).reshape(e, 3),
+            information=np.asarray(self._e_info, dtype=np.float64).reshape(e, 3, 3),
+        )
+
+    def keyframe_poses(self) -> FloatArray:
+        """``(K, 3)`` current keyframe estimates."""
+        return self._kf_pose.copy()
+
+    def scan_poses(self) -> FloatArray:
+        """``(N, 3)`` current pose of every processed scan.
+
+        A scan between keyframes ``r`` and ``r + 1`` is placed relative to both optimised
+        keyframes (through its relative pose to ``r`` and ``r + 1``'s relative pose to
+        ``r`` as matched) and the two placements are blended by the scan's position
+        between the keyframes.
+        """
+        n = len(self._scan_ref)
+        if n == 0:
+            return np.zeros((0, 3))
+        ref = np.asarray(self._scan_ref, dtype=np.intp)
+        rel = np.asarray(self._scan_rel, dtype=np.float64)
+        a = _compose(self._kf_pose[ref], rel)
+        k = self.num_keyframes
+        idx = np.asarray(self._kf_scan_index, dtype=np.intp)
+        has_next = ref + 1 < k
+        if np.any(has_next):
+            r = ref[has_next]
+            nxt = r + 1
+            b = _compose(
+                _compose(self._kf_pose[nxt], _inverse(self._kf_prev_rel[nxt])), rel[has_next]
+            )
+            s = np.flatnonzero(has_next)
+            w = (s - idx[r]) / np.maximum(idx[nxt] - idx[r], 1)
+            delta = _relative(a[has_next], b)
+            a[has_next] = _compose(a[has_next], delta * w[:, None])
+        return a
+
+    def occupancy(self) -> GraphMap:
+        """The map rendered from the current (optimised) poses with the shared
+        :class:`~roverlab.maps.grid.CountGrid` (Karto's ``OccupancyGrid`` rule)."""
+        p = self.params
+        if self.num_keyframes == 0:
+            return GraphMap(np.full((1, 1), -1, dtype=np.int8), p.resolution, (0.0, 0.0))
+        if p.map_scans == "all":
+            poses, scans = self.scan_poses(), self._all_scans
+        else:
+            poses, scans = self._kf_pose, self._kf_scans
+        lasers = _compose(poses, np.asarray([s.laser_offset for s in scans]))
+        x0, y0 = lasers[:, :2].min(axis=0) - 1.0
+        x1, y1 = lasers[:, :2].max(axis=0) + 1.0
+        res = p.resolution
+        ox = math.floor(x0 / res) * res
+        oy = math.floor(y0 / res) * res
+        grid = CountGrid(
+            max(1, math.ceil((x1 - ox) / res)), max(1, math.ceil((y1 - oy) / res)), res, (ox, oy)
+        )
+        for pose, scan in zip(lasers, scans, strict=True):
+            grid.update_scan(
+                pose,
+                scan.ranges,
+                scan.angles,
+                scan.range_max if math.isfinite(scan.range_max) else 1e9,
+                range_min=max(scan.range_min, p.min_laser_range),
+                usable_range=p.max_laser_range,
+                grow=True,
+            )
+        data = grid.to_occupancy(occupied_thresh=OCCUPANCY_THRESHOLD)
+        data[grid.visits <= MIN_PASS_THROUGH] = -1
+        return GraphMap(data, res, grid.origin_xy)
+
+    # ---------------------------------------------------------------- batch
+    def run_log(self, log: Iterable[ScanLike]) -> GraphRun:
+        """Process every scan of a laser log (a ``roverlab.slam.data.LaserLog``) in order, then
+        optimise the graph once more and return one final pose per scan and the map."""
+        stamps: list[str] = []
+        for rec in log:
+            ranges = np.asarray(rec.ranges)
+            angles = rec.angle_min + rec.angle_increment * np.arange(ranges.size)
+            self.process(
+                ranges,
+                angles,
+                rec.odom_pose,
+                float(rec.timestamp),
+                range_min=float(rec.range_min),
+                range_max=float(rec.range_max),
+                laser_offset=rec.laser_offset,
+            )
+            stamps.append(rec.timestamp_text or f"{rec.timestamp:.6f}")
+        self.optimise()
+        poses = self.scan_poses()
+        return GraphRun(
+            poses=poses, map=self.occupancy(), trajectory=Trajectory.from_poses(stamps, poses)
+        )
+
+
+def _weighted_mean(means: list[FloatArray], covs: list[FloatArray]) -> FloatArray:
+    """Karto's ``ComputeWeightedMean``: positions weighted by inverse covariance, heading
+    the circular mean."""
+    infos = [np.linalg.inv(c + np.eye(3) * 1e-12) for c in covs]
+    total = np.linalg.inv(np.sum(infos, axis=0))
+    ref = means[0]
+    acc = np.zeros(3)
+    for m, info in zip(means, infos, strict=True):
+        v = m - ref
+        v[2] = _wrap(v[2])
+        acc += total @ info @ v
+    heading = math.atan2(
+        sum(math.sin(float(m[2])) for m in means), sum(math.cos(float(m[2])) for m in means)
+    )
+    return np.array([ref[0] + acc[0], ref[1] + acc[1], heading])
+
+
+def run_log(
+    log: Iterable[ScanLike],
+    params: GraphParams | None = None,
+    rng: np.random.Generator | None = None,
+) -> GraphRun:
+    """Run the graph SLAM over a whole laser log; see :meth:`GraphSLAM.run_log`."""
+    return GraphSLAM(params, rng).run_log(log)
+
+
+def run_graph(records: Iterable[ScanLike], params: Mapping[str, Any] | None = None) -> GraphRun:
+    """One-call entry point for ``roverlab slam run --method graph``: ROS-named parameters
+    (``GraphParams.from_ros``) in, :class:`GraphRun` out.
+
+    Raises:
+        GraphSlamParamsError: an unknown parameter or a bad value.
+    """
+    return GraphSLAM(GraphParams.from_ros(params or {})).run_log(records)

@@ -1,0 +1,372 @@
+"""hector_mapping's processor: scan to map matching plus thresholded map updates.
+
+Per scan (hector's ``HectorSlamProcessor::update``):
+
+1. the beams are filtered (``range_min < r < range_max``, ``laser_min_dist <= r <
+   laser_max_dist``, the laser height within ``laser_z_min/max_value``) and turned into
+   endpoints in the robot frame through the laser offset;
+2. the pose is predicted: the previous estimate (hector's default), the previous estimate
+   moved by the odometry delta when ``use_odometry`` is set, or moved by the previous
+   scan-to-scan motion with ``motion_prediction="constant_velocity"``;
+3. the prediction is refined by the coarse-to-fine Gauss-Newton matcher
+   (:mod:`roverlab.slam.hector.matcher`);
+4. the map pyramid is updated only when the estimate has moved more than
+   ``map_update_distance_thresh`` or turned more than ``map_update_angle_thresh`` since the
+   last update (the first scan always updates).
+
+Poses are of the robot (base) frame in the map frame, whose origin is the first pose.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable
+from typing import NamedTuple
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from roverlab.geometry import SE2, wrap_angle
+from roverlab.slam.common import ScanLike
+from roverlab.slam.data.trajectory import Trajectory
+from roverlab.slam.hector.errors import HectorInputError, OutOfMapError
+from roverlab.slam.hector.grid import HectorMap, MultiResGrid
+from roverlab.slam.hector.matcher import match
+from roverlab.slam.hector.params import HectorParams
+
+__all__ = ["HectorRun", "HectorSLAM", "ScanLike", "run_log"]
+
+_IDENTITY = SE2()
+
+
+class HectorRun(NamedTuple):
+    """Result of a batch run: unpacks as ``poses, map, trajectory``.
+
+    Attributes:
+        poses: (N, 3) robot pose ``x, y, theta`` per scan in the map frame.
+        map: the finest map level after the last scan.
+        trajectory: the same poses with the scans' timestamps (and their exact texts), for
+            ``roverlab.slam.data.write_tum`` and ``roverlab.slam.data.evaluate``.
+    """
+
+    poses: NDArray[np.float64]
+    map: HectorMap
+    trajectory: Trajectory
+
+
+class HectorSLAM:
+    """hector_mapping's algorithm on plain arrays (no node, no clock, no TF).
+
+    Args:
+        params: algorithm parameters (ROS names and defaults).
+        laser_offset: pose of the laser in the robot frame (``base_frame -> laser``).
+        laser_z_m: height of the laser in the robot frame (m), checked against
+            ``laser_z_min_value`` / ``laser_z_max_value`` as hector filters endpoints.
+        initial_pose: robot pose in the map frame before the first scan.
+
+    Attributes:
+        params: the parameters.
+        grid: the map pyramid (:class:`MultiResGrid`).
+        last_hessian: Gauss-Newton Hessian (3, 3) of the last match on the finest level
+            (metres, radians): its inverse, scaled, is hector's pose covariance.
+        scans_processed: scans given to :meth:`process` since the last reset.
+    """
+
+    def __init__(
+        self,
+        params: HectorParams | None = None,
+        *,
+        laser_offset: SE2 = _IDENTITY,
+        laser_z_m: float = 0.0,
+        initial_pose: SE2 = _IDENTITY,
+        grow_max_size: int = 0,
+    ) -> None:
+        """``grow_max_size``: when the robot or a scan's end point falls outside the map,
+        double the map (around its centre) until it holds them, up to this many cells per
+        side (0: hector_mapping's fixed map, which drops such end points and raises
+        :class:`OutOfMapError` when the robot leaves)."""
+        self.params = params if params is not None else HectorParams()
+        self.grow_max_size = int(grow_max_size)
+        self.laser_offset = laser_offset
+        self.laser_z_m = float(laser_z_m)
+        self.grid = MultiResGrid(self.params)
+        self._initial = np.array([initial_pose.x, initial_pose.y, initial_pose.theta])
+        self.reset()
+
+    def reset(self) -> None:
+        """Back to an empty map at the initial pose (hector's ``syscommand reset``)."""
+        self.grid.reset()
+        self._pose = self._initial.copy()
+        self._last_update_pose: NDArray[np.float64] | None = None
+        self._last_odom: NDArray[np.float64] | None = None
+        self._last_motion: NDArray[np.float64] | None = None
+        self.last_hessian = np.zeros((3, 3))
+        self.scans_processed = 0
+
+    @property
+    def pose(self) -> SE2:
+        """The latest robot pose estimate in the map frame."""
+        return SE2(float(self._pose[0]), float(self._pose[1]), float(self._pose[2]))
+
+    @property
+    def map_updates(self) -> int:
+        """How many scans were integrated into the map."""
+        return self.grid.updates
+
+    def occupancy(self, level: int = 0) -> HectorMap:
+        """A map level (0 is the finest) as an int8 occupancy grid."""
+        if not 0 <= level < self.params.map_multi_res_levels:
+            raise HectorInputError(f"no map level {level}")
+        return self.grid.occupancy(level)
+
+    def scan_points(
+        self,
+        ranges: ArrayLike,
+        angles: ArrayLike,
+        *,
+        range_min: float = 0.0,
+        range_max: float = math.inf,
+        laser_offset: SE2 | None = None,
+    ) -> NDArray[np.float64]:
+        """The usable endpoints of a scan, (N, 2) in the robot frame (m).
+
+        Args:
+            ranges: (N,) ranges (m).
+            angles: (N,) beam angles in the laser frame (rad).
+            range_min: readings at or below this are dropped (m).
+            range_max: readings at or above this are dropped (m).
+            laser_offset: laser pose in the robot frame (default: the constructor's).
+
+        Raises:
+            HectorInputError: mismatched shapes or non-finite angles.
+        """
+        r = np.asarray(ranges, dtype=np.float64).reshape(-1)
+        a = np.asarray(angles, dtype=np.float64).reshape(-1)
+        if r.shape != a.shape:
+            raise HectorInputError(f"{r.size} ranges but {a.size} angles")
+        if not np.all(np.isfinite(a)):
+            raise HectorInputError("beam angles must be finite")
+        p = self.params
+        if not p.laser_z_min_value <= self.laser_z_m <= p.laser_z_max_value:
+            return np.zeros((0, 2))
+        keep = (
+            np.isfinite(r)
+            & (r > range_min)
+            & (r < range_max)
+            & (r >= p.laser_min_dist)
+            & (r < p.laser_max_dist)
+        )
+        r = r[keep]
+        a = a[keep]
+        off = self.laser_offset if laser_offset is None else laser_offset
+        ang = a + off.theta
+        pts = np.empty((r.size, 2))
+        pts[:, 0] = off.x + r * np.cos(ang)
+        pts[:, 1] = off.y + r * np.sin(ang)
+        return pts
+
+    def process(
+        self,
+        scan_ranges: ArrayLike,
+        angles: ArrayLike,
+        odom_pose: ArrayLike | SE2 | None = None,
+        *,
+        range_min: float = 0.0,
+        range_max: float = math.inf,
+        laser_offset: SE2 | None = None,
+    ) -> SE2:
+        """Match one scan, update the map if the robot moved enough, return the pose.
+
+        Args:
+            scan_ranges: (N,) ranges (m); non-finite ones are dropped.
+            angles: (N,) beam angles in the laser frame (rad).
+            odom_pose: the odometry pose ``(x, y, theta)`` at the scan, used only when
+                ``use_odometry`` (delta since the previous scan) or ``map_with_known_poses``
+                (the pose itself) is set.
+            range_min: the sensor's minimum range (m); shorter readings are dropped.
+            range_max: the sensor's maximum range (m); readings at or beyond are dropped.
+            laser_offset: this scan's laser pose in the robot frame (default: the
+                constructor's).
+
+        Returns:
+            The robot pose in the map frame.
+
+        Raises:
+            HectorInputError: mismatched shapes, non-finite angles or odometry, or an
+                odometry pose missing when the parameters need it.
+            OutOfMapError: the estimate left the fixed-size map.
+        """
+        p = self.params
+        off = self.laser_offset if laser_offset is None else laser_offset
+        pts = self.scan_points(
+            scan_ranges, angles, range_min=range_min, range_max=range_max, laser_offset=off
+        )
+        odom = _odom_array(odom_pose)
+        if odom is None and (p.map_with_known_poses or p.use_odometry):
+            raise HectorInputError(
+                "odom_pose is required with map_with_known_poses or use_odometry"
+            )
+
+        if p.map_with_known_poses:
+            assert odom is not None
+            pose = odom.copy()
+        else:
+            pose = self._pose.copy()
+            if p.use_odometry and odom is not None and self._last_odom is not None:
+                pose = _compose(pose, _relative(self._last_odom, odom))
+            elif p.motion_prediction == "constant_velocity" and self._last_motion is not None:
+                pose = _compose(pose, self._last_motion)
+            if pts.shape[0] and self.grid.updates:
+                pose, self.last_hessian = self._match(pts, pose)
+        pose[2] = wrap_angle(float(pose[2]))
+        self._grow_to_hold(pose, pts)
+        self._check_inside(pose)
+        self._last_odom = odom
+        self._last_motion = _relative(self._pose, pose)
+        self._pose = pose
+        self.scans_processed += 1
+
+        if pts.shape[0] and (
+            p.map_with_known_poses
+            or self._last_update_pose is None
+            or _moved(self._last_update_pose, pose, p)
+        ):
+            self.grid.update(pose, np.array([off.x, off.y]), pts)
+            self._last_update_pose = pose.copy()
+        return self.pose
+
+    def match_scan(
+        self,
+        scan_ranges: ArrayLike,
+        angles: ArrayLike,
+        start: SE2,
+        *,
+        range_min: float = 0.0,
+        range_max: float = math.inf,
+        laser_offset: SE2 | None = None,
+    ) -> SE2:
+        """Match one scan against the current map from ``start``; change nothing.
+
+        Returns ``start`` itself when the map is empty or the scan has no usable beam.
+        """
+        pts = self.scan_points(
+            scan_ranges, angles, range_min=range_min, range_max=range_max, laser_offset=laser_offset
+        )
+        begin = start.as_array()
+        if not pts.shape[0] or not self.grid.updates:
+            return start
+        pose, _ = self._match(pts, begin)
+        return SE2(float(pose[0]), float(pose[1]), float(pose[2]))
+
+    def _match(
+        self, pts: NDArray[np.float64], start: NDArray[np.float64]
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        p = self.params
+        return match(
+            self.grid.prob,
+            self.grid.offsets,
+            self.grid.sizes,
+            self.grid.inv_res,
+            self.grid.centers,
+            pts,
+            start,
+            iters_coarse=p.scan_match_iterations_coarse,
+            iters_fine=p.scan_match_iterations_fine,
+            angle_search=p.scan_match_angle_search,
+            angle_search_step=p.scan_match_angle_search_step,
+            translation_search_cells=p.translation_search_cells(),
+            damped=p.scan_match_damping,
+        )
+
+    def run_log(self, log: Iterable[ScanLike]) -> HectorRun:
+        """Process every scan of a laser log (a ``roverlab.slam.data.LaserLog``) in order.
+
+        Each record's ``laser_offset`` places the laser on the robot; the poses returned
+        are of the robot (odometry) frame, one per scan.
+        """
+        poses: list[NDArray[np.float64]] = []
+        stamps: list[str] = []
+        for rec in log:
+            ranges = np.asarray(rec.ranges)
+            angles = rec.angle_min + rec.angle_increment * np.arange(ranges.size)
+            pose = self.process(
+                ranges,
+                angles,
+                rec.odom_pose,
+                range_min=float(rec.range_min),
+                range_max=float(rec.range_max),
+                laser_offset=rec.laser_offset,
+            )
+            poses.append(pose.as_array())
+            stamps.append(rec.timestamp_text or f"{rec.timestamp:.6f}")
+        arr = np.array(poses, dtype=np.float64).reshape(-1, 3)
+        return HectorRun(
+            poses=arr, map=self.occupancy(0), trajectory=Trajectory.from_poses(stamps, arr)
+        )
+
+    def _grow_to_hold(self, pose: NDArray[np.float64], pts: NDArray[np.float64]) -> None:
+        """Double the map until it holds the robot and this scan's end points."""
+        x, y, th = float(pose[0]), float(pose[1]), float(pose[2])
+        if not (self.grow_max_size and math.isfinite(x) and math.isfinite(y)):
+            return
+        c, s = math.cos(th), math.sin(th)
+        xs = np.append(x + c * pts[:, 0] - s * pts[:, 1], x)
+        ys = np.append(y + s * pts[:, 0] + c * pts[:, 1], y)
+        lo, hi = (float(xs.min()), float(ys.min())), (float(xs.max()), float(ys.max()))
+        while not (self.grid.contains(*lo, 2.0) and self.grid.contains(*hi, 2.0)):
+            if 2 * int(self.grid.sizes[0]) > self.grow_max_size:
+                return
+            self.grid.grow()
+
+    def _check_inside(self, pose: NDArray[np.float64]) -> None:
+        x, y = float(pose[0]), float(pose[1])
+        if not (math.isfinite(x) and math.isfinite(y)) or not self.grid.contains(x, y, 2.0):
+            x0, y0, x1, y1 = self.grid.extent()
+            raise OutOfMapError(
+                f"the robot at ({x:.2f}, {y:.2f}) m left the map "
+                f"[{x0:.2f}, {x1:.2f}] x [{y0:.2f}, {y1:.2f}] m"
+                + (
+                    f"; it cannot grow beyond {self.grow_max_size} cells per side"
+                    if self.grow_max_size
+                    else "; increase map_size (or map_resolution) or move map_start_x/map_start_y"
+                )
+            )
+
+
+def run_log(log: Iterable[ScanLike], params: HectorParams | None = None) -> HectorRun:
+    """Run hector_mapping over a whole laser log; see :meth:`HectorSLAM.run_log`."""
+    return HectorSLAM(params).run_log(log)
+
+
+def _odom_array(odom_pose: ArrayLike | SE2 | None) -> NDArray[np.float64] | None:
+    if odom_pose is None:
+        return None
+    if isinstance(odom_pose, SE2):
+        arr = odom_pose.as_array()
+    else:
+        arr = np.asarray(odom_pose, dtype=np.float64).reshape(-1)
+    if arr.shape != (3,) or not np.all(np.isfinite(arr)):
+        raise HectorInputError(f"odom_pose must be 3 finite numbers (x, y, theta), got {arr}")
+    return arr
+
+
+def _relative(a: NDArray[np.float64], b: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``a^-1 * b`` for poses ``(x, y, theta)``."""
+    c, s = math.cos(a[2]), math.sin(a[2])
+    dx, dy = b[0] - a[0], b[1] - a[1]
+    return np.array([c * dx + s * dy, -s * dx + c * dy, wrap_angle(float(b[2] - a[2]))])
+
+
+def _compose(a: NDArray[np.float64], d: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``a * d`` for poses ``(x, y, theta)``."""
+    c, s = math.cos(a[2]), math.sin(a[2])
+    return np.array(
+        [a[0] + c * d[0] - s * d[1], a[1] + s * d[0] + c * d[1], wrap_angle(float(a[2] + d[2]))]
+    )
+
+
+def _moved(last: NDArray[np.float64], pose: NDArray[np.float64], p: HectorParams) -> bool:
+    """hector's ``poseDifferenceLargerThan``: moved beyond either update threshold."""
+    if math.hypot(pose[0] - last[0], pose[1] - last[1]) > p.map_update_distance_thresh:
+        return True
+    return abs(wrap_angle(float(pose[2] - last[2]))) > p.map_update_angle_thresh
