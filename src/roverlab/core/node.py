@@ -192,7 +192,8 @@ class _TimerFire:
         if nxt <= now:  # the clock jumped past whole periods: skip them, as rcl does
             nxt += ((now - nxt) // period + 1) * period
         timer._next_ns = nxt
-        heapq.heappush(ex._heap, (nxt, next(ex._seq), self))  # ex.call_at, inlined
+        entry: tuple[int, int, Callable[[], Any]] = (nxt, next(ex._seq), self)
+        heapq.heappush(ex._heap, entry)  # ex.call_at, inlined
         timer.callback()
 
 
