@@ -60,25 +60,6 @@ def fan_step(angles: NDArray[np.float64]) -> float:
 
 
 @_jit
-def _test_one(
-    k: int,
-    ox: float,
-    oy: float,
-    dxs: NDArray[np.float64],
-    dys: NDArray[np.float64],
-    kind: int,
-    p: NDArray[np.float64],
-    out: NDArray[np.float64],
-) -> None:
-    if kind == 0:
-        t = segment_distance(ox, oy, dxs[k], dys[k], p[0], p[1], p[2], p[3], out[k])
-    else:
-        t, _ = circle_hit(ox, oy, dxs[k], dys[k], p[0], p[1], p[2])
-    if t < out[k]:
-        out[k] = t
-
-
-@_jit
 def _test_range(
     k0: int,
     k1: int,
@@ -94,8 +75,14 @@ def _test_range(
     """Beams ``k0..k1``; those already holding a hit nearer than ``skip`` (below the
     primitive's nearest distance, with room for rounding) cannot change and are passed."""
     for k in range(max(k0, 0), min(k1, out.shape[0] - 1) + 1):
-        if out[k] >= skip:
-            _test_one(k, ox, oy, dxs, dys, kind, p, out)
+        if out[k] < skip:
+            continue
+        if kind == 0:
+            t = segment_distance(ox, oy, dxs[k], dys[k], p[0], p[1], p[2], p[3], out[k])
+        else:
+            t, _ = circle_hit(ox, oy, dxs[k], dys[k], p[0], p[1], p[2])
+        if t < out[k]:
+            out[k] = t
 
 
 @_jit

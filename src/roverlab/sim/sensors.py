@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 import sys
 from dataclasses import dataclass
+from typing import Any
 
 import numba
 import numpy as np
@@ -242,20 +243,7 @@ class CameraModel:
     def capture(
         self, scene: Scene, x: float, y: float, z: float, yaw: float, pitch: float = 0.0
     ) -> tuple[NDArray[np.uint8], NDArray[np.float32]]:
-        p = self.params
-        rgb, depth = render(
-            scene,
-            x,
-            y,
-            z,
-            yaw,
-            hfov=p.horizontal_fov,
-            width=p.width,
-            height=p.height,
-            near=p.clip_near,
-            far=p.clip_far,
-            pitch=pitch,
-        )
+        rgb, depth = render(scene, x, y, z, yaw, pitch=pitch, **self._optics())
         return self._noisy(rgb), depth
 
     def capture_rgb(
@@ -267,22 +255,18 @@ class CameraModel:
         nothing else refers to it any more (a message holding it keeps it alive), which
         saves the operating system handing out fresh pages for every frame.
         """
+        out = self._free_buffer()
+        return self._noisy(render_rgb(scene, x, y, z, yaw, pitch=pitch, out=out, **self._optics()))
+
+    def _optics(self) -> dict[str, Any]:
         p = self.params
-        rgb = render_rgb(
-            scene,
-            x,
-            y,
-            z,
-            yaw,
-            hfov=p.horizontal_fov,
-            width=p.width,
-            height=p.height,
-            near=p.clip_near,
-            far=p.clip_far,
-            pitch=pitch,
-            out=self._free_buffer(),
-        )
-        return self._noisy(rgb)
+        return {
+            "hfov": p.horizontal_fov,
+            "width": p.width,
+            "height": p.height,
+            "near": p.clip_near,
+            "far": p.clip_far,
+        }
 
     def _free_buffer(self) -> NDArray[np.uint8] | None:
         """An image of the pool nobody else refers to, a new pooled one, or None."""
