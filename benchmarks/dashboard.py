@@ -192,6 +192,8 @@ def _measure(
     cpu = _cpu_s() - cpu0
     drawn = page.evaluate("() => viz.data.layers[3].points.at(-1).n")  # the Depth display
     ms = page.evaluate("() => [viz.cam.msUpdate || 0, viz.cam.msRender || 0, viz.cam.resolution]")
+    # frames drawn back to back, each waited for: the software GPU's own time per frame
+    synced = page.evaluate("() => viz.renderSync(10)") if view == "3d" else 0.0
     page.close()
     return {
         "fps": frames / wall,
@@ -203,6 +205,7 @@ def _measure(
         "ms_update": float(ms[0]),
         "ms_render": float(ms[1]),
         "resolution": float(ms[2]),
+        "ms_synced": float(synced),
     }
 
 
@@ -254,6 +257,7 @@ def main() -> None:
                     f"{r['ms_render']:.1f} ms WebGL render"
                 )
                 print(f"    adaptive resolution:      {r['resolution']:6.3f} of full (per axis)")
+                print(f"    synced frame (GPU work):  {r['ms_synced']:6.1f} ms")
             print(f"    server process CPU:       {r['cpu']:6.1f} % of one core")
             print(f"    websocket traffic:        {r['kib']:6.1f} KiB/s")
     finally:

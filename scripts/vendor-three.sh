@@ -16,10 +16,13 @@ if [ "$GOT" != "$INTEGRITY" ]; then
   exit 1
 fi
 tar -xzf "$TGZ" -C "$TMP"
-mkdir -p "$DEST/addons/controls" "$DEST/addons/loaders" "$DEST/addons/utils"
+mkdir -p "$DEST/addons/controls" "$DEST/addons/loaders" "$DEST/addons/utils" "$DEST/addons/lines"
 cp "$TMP/package/build/three.module.min.js" "$TMP/package/LICENSE" "$DEST/"
 cp "$TMP/package/examples/jsm/controls/OrbitControls.js" "$DEST/addons/controls/"
 cp "$TMP/package/examples/jsm/loaders/STLLoader.js" "$TMP/package/examples/jsm/loaders/ColladaLoader.js" "$DEST/addons/loaders/"
 cp "$TMP/package/examples/jsm/loaders/TGALoader.js" "$DEST/addons/loaders/"
+for f in Line2 LineGeometry LineMaterial LineSegments2 LineSegmentsGeometry; do  # Marker line widths
+  cp "$TMP/package/examples/jsm/lines/$f.js" "$DEST/addons/lines/"
+done
 echo "three@$VERSION ($INTEGRITY), from the npm registry by scripts/vendor-three.sh" > "$DEST/VERSION"
 echo "vendored three@$VERSION into $DEST"

@@ -4,6 +4,7 @@ statuses, Save map, compressed images, drive speeds."""
 from __future__ import annotations
 
 import io
+import json
 import struct
 from pathlib import Path
 
@@ -14,13 +15,19 @@ from PIL import Image
 from roverlab.core import Context, QoSProfile, Time
 from roverlab.geometry import Transform3
 from roverlab.maps import load_map
-from roverlab.msgs import CompressedImage, array_to_occupancy_grid, make, pose_from_xytheta
+from roverlab.msgs import (
+    CompressedImage,
+    array_to_occupancy_grid,
+    make,
+    make_scan,
+    pose_from_xytheta,
+)
 from roverlab.tf import StaticTransformBroadcaster
 from roverlab.tf.convert import transform_to_msg
 from roverlab.viz.bridge import VizBridge
 from roverlab.viz.config import DashboardConfig, DisplayConfig
 from roverlab.viz.errors import DashboardError
-from roverlab.viz.protocol import KIND_MAP, KIND_MAP_PATCH, KIND_POSES
+from roverlab.viz.protocol import KIND_MAP, KIND_MAP_PATCH, KIND_POSES, POSES_3D
 
 LATCHED = QoSProfile(depth=1, durability="transient_local")
 
@@ -102,8 +109,9 @@ def test_statuses_no_publisher_no_messages_tf_failure_and_ok() -> None:
     assert _rows(bridge, 0)["Topic"][0] == "ok" and _rows(bridge, 0)["Transform"][0] == "ok"
     frame = bridge.displays[0].frame
     assert frame is not None and frame.payload[0] == KIND_POSES
-    xyyaw = np.frombuffer(frame.payload[8:], dtype="<f4")
-    assert np.allclose(xyyaw, [2.0, 2.0, 0.0])  # odom is 1 m along map's x
+    assert frame.payload[1] == POSES_3D
+    pose = np.frombuffer(frame.payload[8:], dtype="<f4")
+    assert np.allclose(pose, [2.0, 2.0, 0.0, 0.0, 0.0, 0.0, 1.0])  # odom is 1 m along map's x
     level, text = _rows(bridge, 1)["Transform"]
     assert level == "error" and "ghost" in text
     assert _rows(bridge, 2)["Topic"] == ("warn", "No messages received on /quiet")
@@ -206,7 +214,64 @@ def test_marker_lifetime_expires_on_the_executor_clock() -> None:
     ctx.spin_for(0.5)
     frame = bridge.displays[0].frame
     assert frame is not None and '"polygon"' in frame.payload
+    solid = json.loads(frame.payload)["items3d"][0]
+    assert solid["type"] == 1 and solid["pose"] == [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0]
     ctx.spin_for(1.0)
     frame = bridge.displays[0].frame
-    assert frame is not None and frame.payload == "[]"
+    assert frame is not None and json.loads(frame.payload) == {"items": [], "items3d": []}
+    ctx.shutdown()
+
+
+def _points_frame(payload: bytes) -> tuple[np.ndarray, np.ndarray]:
+    """``(points, rgba per point)`` of a KIND_POINTS frame (bucketed colours)."""
+    n, nb = struct.unpack_from("<II", payload, 4)
+    counts = np.frombuffer(payload, "<u4", nb, 12)
+    palette = np.frombuffer(payload, np.uint8, 4 * nb, 12 + 4 * nb).reshape(nb, 4)
+    dims = 3 if payload[1] & 1 else 2
+    pts = np.frombuffer(payload, "<f4", n * dims, 12 + 8 * nb).reshape(n, dims)
+    return pts, np.repeat(palette, counts, axis=0)
+
+
+def test_intensity_transformer_colours_scans_and_clouds() -> None:
+    ctx = Context()
+    node = ctx.create_node("pub")
+    StaticTransformBroadcaster(node).send_transform(
+        transform_to_msg("map", "laser", Time(0), Transform3((0.0, 0.0, 0.5)))
+    )
+    scans = node.create_publisher("sensor_msgs/msg/LaserScan", "/scan", 10)
+    clouds = node.create_publisher("sensor_msgs/msg/PointCloud2", "/cloud", 10)
+    fixed = {"color_transformer": "Intensity", "autocompute_intensity_bounds": False,
+             "min_intensity": 0.0, "max_intensity": 100.0, "use_rainbow": False,
+             "min_color": [0, 0, 255], "max_color": [255, 255, 0]}  # fmt: skip
+    bridge = VizBridge(context=ctx, config=_config(
+        DisplayConfig("laser_scan", "s", True, "/scan", {"color_transformer": "Intensity"}),
+        DisplayConfig("point_cloud2", "c", True, "/cloud", fixed),
+        DisplayConfig("point_cloud2", "m", True, "/cloud", {"color_transformer": "Intensity",
+                                                            "channel_name": "heat"}),
+    ))  # fmt: skip
+    ctx.spin_for(0.1)
+    scans.publish(make_scan(np.array([1.0, np.nan, 1.0, 1.0]), angle_min=0.0, angle_max=1.5,
+                            range_min=0.1, range_max=5.0, frame_id="laser",
+                            intensities=np.array([5.0, 0.0, 50.0, 500.0])))  # fmt: skip
+    data = np.array([[1.0, 0, 0, -10.0], [2.0, 0, 0, 50.0], [3.0, 0, 0, 250.0]], "<f4")
+    clouds.publish(make("sensor_msgs/msg/PointCloud2", header={"frame_id": "laser"},
+                        height=1, width=3, point_step=16, row_step=48, is_dense=True,
+                        fields=[{"name": n, "offset": 4 * i, "datatype": 7, "count": 1}
+                                for i, n in enumerate(("x", "y", "z", "intensity"))],
+                        data=data.tobytes()))  # fmt: skip
+    ctx.spin_for(0.2)
+    scan, fixed_cloud, missing = bridge.displays
+    assert missing.frame is not None  # drawn flat
+    assert scan.frame is not None and fixed_cloud.frame is not None
+    pts, rgba = _points_frame(scan.frame.payload)
+    assert len(pts) == 3 and np.allclose(pts[:, 2], 0.5)  # the NaN beam dropped, at 0.5 m
+    # autocomputed over the valid beams (5..500): lowest red, highest magenta
+    assert scan.info["bounds"] == [5.0, 500.0]
+    assert rgba[0, :3].tolist() == [255, 0, 0] and rgba[-1, :3].tolist() == [255, 0, 255]
+    pts, rgba = _points_frame(fixed_cloud.frame.payload)
+    order = np.argsort(pts[:, 0])
+    got = rgba[order, :3].tolist()
+    assert got[0] == [0, 0, 255] and got[2] == [255, 255, 0]  # clipped to 0..100
+    assert abs(got[1][0] - 128) <= 3 and abs(got[1][2] - 128) <= 3  # half way
+    assert _rows(bridge, 2)["Color Transformer"][0] == "warn"  # no 'heat' channel: flat
     ctx.shutdown()

@@ -96,6 +96,46 @@ Visualization Manager:
     assert cam.kind == "image" and cam.topic == "/camera/image_raw/compressed"
 
 
+def test_point_colour_transformer_properties_are_read() -> None:
+    text = """
+Visualization Manager:
+  Displays:
+    - Class: rviz/LaserScan
+      Name: Scan
+      Topic: /scan
+      Color Transformer: Intensity
+      Channel Name: intensities
+      Autocompute Intensity Bounds: false
+      Min Intensity: 100
+      Max Intensity: 3000
+      Use rainbow: false
+      Invert Rainbow: true
+      Min Color: 0; 0; 255
+      Max Color: 255; 255; 0
+    - Class: rviz/PointCloud2
+      Name: Cloud
+      Topic: /points
+      Color Transformer: AxisColor
+      Axis: X
+      Autocompute Value Bounds:
+        Max Value: 4
+        Min Value: -1
+        Value: false
+      Use Fixed Frame: false
+"""
+    scan, cloud = parse_rviz(text, "colours.rviz").displays
+    assert scan.option("channel_name") == "intensities"
+    assert scan.option("autocompute_intensity_bounds") is False
+    assert (scan.option("min_intensity"), scan.option("max_intensity")) == (100.0, 3000.0)
+    assert scan.option("use_rainbow") is False and scan.option("invert_rainbow") is True
+    assert scan.option("min_color") == [0, 0, 255] and scan.option("max_color") == [255, 255, 0]
+    assert cloud.option("axis") == "X" and cloud.option("autocompute_value_bounds") is False
+    assert (cloud.option("min_value"), cloud.option("max_value")) == (-1.0, 4.0)
+    assert cloud.option("use_fixed_frame") is False
+    with pytest.raises(ConfigError, match="axis"):
+        parse_rviz(text.replace("Axis: X", "Axis: W"), "bad.rviz")
+
+
 @pytest.mark.parametrize(
     ("text", "needle"),
     [

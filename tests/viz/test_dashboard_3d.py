@@ -274,3 +274,42 @@ def test_stl_mesh_visual_is_loaded_and_drawn(browser: Any, tmp_path: Path) -> No
     finally:
         server.stop()
         ctx.shutdown()
+
+
+def test_collada_mesh_visual_keeps_its_colour_and_z_up(browser: Any, tmp_path: Path) -> None:
+    """The book's kinect.dae (a Z_UP box 0.07 x 0.28 x 0.07 m, red in its own material,
+    no URDF material): drawn red, long along y, seen from above."""
+    dae = Path(__file__).parents[1] / "ros1_packages/book_robot_description/meshes/kinect.dae"
+    urdf = f"""<robot name="daebot">
+      <link name="base_link"><visual><geometry><mesh filename="file://{dae}" scale="3 3 3"/>
+      </geometry></visual></link>
+    </robot>"""
+    ctx = Context()
+    RobotStatePublisher(ctx, robot_description=urdf)
+    config = load_rviz(URDLEE / "config" / "showmycar.rviz")  # Orbit, fixed frame base_link
+    server = DashboardServer(ctx, "127.0.0.1", 0, config=config)
+    ctx.spin_in_thread()
+    server.start()
+    try:
+        page = _open(browser, server, "viz.meshes.loaded + viz.meshes.failed > 0")
+        assert page.evaluate("() => viz.meshes") == {"loaded": 1, "failed": 0}
+        page.evaluate(
+            "() => { viz.cam.distance = 2.5; viz.cam.focal.set(0, 0, 0);"
+            " viz.cam.pitch = 1.45; viz.cam.yaw = 0; }"
+        )
+        page.wait_for_timeout(500)
+        img = _shot(page, tmp_path / "dae_mesh.png")
+
+        def red_at(x: float, y: float) -> bool:
+            sx, sy = _screen(page, x, y, 0.1)
+            px = img[int(sy) - 2 : int(sy) + 3, int(sx) - 2 : int(sx) + 3].reshape(-1, 3)
+            return bool(((px[:, 0] > 120) & (px[:, 1] < 70) & (px[:, 2] < 70)).sum() > 12)
+
+        # scaled 3x: 0.84 m along y, 0.21 m across x and z (the file's Z_UP kept as ROS z)
+        assert red_at(0.0, 0.0) and red_at(0.0, 0.35) and red_at(0.0, -0.35)
+        assert not red_at(0.3, 0.0) and not red_at(-0.3, 0.0)
+        assert not page.errors
+        page.close()
+    finally:
+        server.stop()
+        ctx.shutdown()

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from roverlab.geometry import Transform3, quat_from_rpy, quat_from_yaw
+from roverlab.geometry import Transform3, quat_from_rpy, quat_from_yaw, quat_multiply
 from roverlab.msgs import Marker, pose_from_xytheta
 from roverlab.viz.displays import (
     MarkerStore,
@@ -15,9 +15,12 @@ from roverlab.viz.displays import (
     color_buckets,
     decimate,
     map_change,
+    marker_3d,
     marker_primitives,
     pose_covariance_primitives,
+    poses3_in_fixed,
     poses_in_fixed,
+    yaw_of_poses3,
 )
 
 SHIFT = Transform3((10.0, 0.0, 0.0))  # fixed_from_frame: the marker frame 10 m along x
@@ -134,12 +137,14 @@ def test_map_change_window() -> None:
 
 
 def test_colour_buckets_and_decimation() -> None:
-    idx, pal = color_buckets("FlatColor", count=5, flat_rgb=[1, 2, 3], alpha=0.5)
-    assert idx is None and pal.tolist() == [[1, 2, 3, 128]]
+    idx, pal, bounds = color_buckets("FlatColor", count=5, flat_rgb=[1, 2, 3], alpha=0.5)
+    assert idx is None and pal.tolist() == [[1, 2, 3, 128]] and bounds is None
     z = np.array([0.0, 0.5, 1.0, np.nan])
-    idx, pal = color_buckets("AxisColor", count=4, flat_rgb=[0, 0, 0], alpha=1.0, values=z)
-    assert idx is not None and idx.tolist() == [0, 16, 31, 0] and len(pal) == 32
-    assert pal[0, :3].tolist() == [255, 0, 255] and pal[-1, :3].tolist() == [255, 0, 0]
+    idx, pal, bounds = color_buckets("AxisColor", count=4, flat_rgb=[0, 0, 0], alpha=1.0, values=z)
+    assert idx is not None and idx.tolist() == [0, 32, 63, 0] and len(pal) == 64
+    assert bounds == (0.0, 1.0)
+    # rviz's AxisColor: the lowest point red, the highest magenta
+    assert pal[0, :3].tolist() == [255, 0, 0] and pal[-1, :3].tolist() == [255, 0, 255]
     pts = np.arange(100_000).reshape(-1, 2)
     assert len(decimate(pts, 20_000)) <= 20_000 and len(decimate(pts, 0)) == 50_000
 
@@ -166,3 +171,27 @@ def test_pose_covariance_primitives_draw_the_sigma_ellipse_and_yaw_wedge() -> No
     only = pose_covariance_primitives((0, 0, 0), np.full((2, 2), np.nan), 0.0, rgb=[0, 0, 0],
                                       alpha=1.0, length=1.0)  # fmt: skip
     assert [i["shape"] for i in only] == ["arrow"]
+
+
+def test_poses3_keep_height_and_full_orientation() -> None:
+    tf = Transform3((1.0, 0.0, 0.5), tuple(quat_from_yaw(math.pi / 2)))
+    pitch = quat_from_rpy(0.0, -math.pi / 4, 0.0)
+    out = poses3_in_fixed(tf, np.array([[1.0, 0.0, 1.0]]), np.array([pitch]))
+    assert np.allclose(out[0, :3], [1.0, 1.0, 1.5])
+    want = quat_multiply(quat_from_yaw(math.pi / 2), pitch)
+    assert np.allclose(out[0, 3:], want) and yaw_of_poses3(out)[0] == pytest.approx(math.pi / 2)
+    zero = poses3_in_fixed(Transform3(), np.zeros((1, 3)), np.zeros((1, 4)))
+    assert zero[0, 3:].tolist() == [0.0, 0.0, 0.0, 1.0]  # a zero quaternion: identity
+
+
+def test_marker_3d_keeps_pose_scale_points_and_text() -> None:
+    m = _marker(type=4, points=[{"x": 0.0, "y": 0.0, "z": 1.0}, {"x": 1.0, "y": 0.0, "z": 2.0}])
+    m.pose.orientation.x, m.pose.orientation.w = math.sin(0.25), math.cos(0.25)
+    m.colors = [m.color, m.color]
+    solid = marker_3d(m, Transform3((0.0, 0.0, 1.0)))
+    assert solid["type"] == 4 and solid["pose"][2] == pytest.approx(m.pose.position.z + 1.0)
+    assert solid["pose"][3] == pytest.approx(math.sin(0.25), abs=1e-6)
+    assert solid["points"] == [[0.0, 0.0, 1.0], [1.0, 0.0, 2.0]] and len(solid["colors"]) == 2
+    assert "text" not in solid
+    text = marker_3d(_marker(type=9, text="hi"), Transform3())
+    assert text["text"] == "hi" and "points" not in text

@@ -31,7 +31,8 @@ def foxglove(
     ] = None,
 ) -> None:
     """Serve every topic to Foxglove over its WebSocket protocol (ROS 2 CDR + ros2msg
-    schemas); clients may publish (teleop on /cmd_vel, goals, /initialpose).
+    schemas); clients may publish (teleop on /cmd_vel, goals, /initialpose), call every
+    service (e.g. /move_base/clear_costmaps) and get / set node parameters (/node.param).
 
     In Foxglove: Open connection -> Foxglove WebSocket -> ws://HOST:PORT (add ?token=T off
     loopback). SIGINT / SIGTERM / SIGHUP stop it.
@@ -60,7 +61,11 @@ def foxglove(
                 typer.echo(f"foxglove: ws://{host}:{relay.port}/?token=<token>")
             else:
                 typer.echo(f"foxglove: ws://{host}:{bridge.port}")
-            typer.echo(f"serving {len(bridge.topics)} topics (more as they appear)", err=True)
+            typer.echo(
+                f"serving {len(bridge.topics)} topics and {len(bridge.services)} services"
+                " (more as they appear)",
+                err=True,
+            )
             stop.wait()
         finally:
             if relay is not None:

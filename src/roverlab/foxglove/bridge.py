@@ -6,11 +6,20 @@ publisher here or in another process becomes a channel with ROS 2 CDR messages a
 only subscribed in roverlab while a client subscribes to it. Clients may publish (the
 ``clientPublish`` capability) in ``cdr`` or ``json``: teleop on /cmd_vel, a goal on
 /move_base_simple/goal or /goal_pose, an estimate on /initialpose.
+
+Services (``services``): every service served here or in another process is advertised
+with its ``ros2msg`` request and response schemas; a client's call (CDR, or JSON) is
+made with a roverlab client and answered in CDR, a failure (no answer within
+:data:`SERVICE_TIMEOUT_S`, a server error) as the protocol's call failure with the reason.
+Parameters (``parameters``): the nodes' parameters as ``/node.param``
+(:mod:`roverlab.foxglove.params`), read and set by clients; a set is published to the
+clients subscribed to the parameter.
 """
 
 from __future__ import annotations
 
 import json
+import struct
 import threading
 import time
 from collections.abc import Callable
@@ -19,14 +28,25 @@ from typing import Any
 import foxglove
 from foxglove.websocket import Capability, ChannelView, Client, ClientChannel, ServerListener
 
+from roverlab.core import Client as ServiceClient
 from roverlab.core import Context, Publisher, QoSProfile, Subscription
 from roverlab.core.transport.zenoh import GraphEntity
 from roverlab.errors import RoverlabError
-from roverlab.msgs import deserialize, from_dict, message_definition, normalize_type_name, serialize
+from roverlab.foxglove.params import NodeParameters
+from roverlab.msgs import (
+    deserialize,
+    from_dict,
+    get_service_type,
+    message_definition,
+    normalize_type_name,
+    serialize,
+)
 
-__all__ = ["FoxgloveBridge", "FoxgloveError"]
+__all__ = ["SERVICE_TIMEOUT_S", "FoxgloveBridge", "FoxgloveError"]
 
 _DISCOVERY_PERIOD_S = 1.0
+SERVICE_TIMEOUT_S = 10.0
+"""How long a client's service call waits for the server (then it fails)."""
 
 
 class FoxgloveError(RoverlabError):
@@ -59,6 +79,9 @@ class FoxgloveBridge(ServerListener):
         self._subs: dict[str, Subscription] = {}
         self._sub_clients: dict[str, set[int]] = {}
         self._client_pubs: dict[tuple[int, int], tuple[Publisher, str, str]] = {}
+        self._services: dict[str, str] = {}  # advertised service -> its type
+        self._service_clients: dict[str, ServiceClient] = {}
+        self.parameters = NodeParameters(context, self._node, remote_graph)
         self._lock = threading.Lock()
         self._stop = threading.Event()
         self.received = 0
@@ -67,7 +90,12 @@ class FoxgloveBridge(ServerListener):
                 name="roverlab",
                 host=host,
                 port=port,
-                capabilities=[Capability.ClientPublish, Capability.Time],
+                capabilities=[
+                    Capability.ClientPublish,
+                    Capability.Time,
+                    Capability.Services,
+                    Capability.Parameters,
+                ],
                 supported_encodings=["cdr", "json"],
                 server_listener=self,
                 context=self._fox,
@@ -80,20 +108,34 @@ class FoxgloveBridge(ServerListener):
         self._thread.start()
 
     # ------------------------------------------------------------------ topics
-    def _graph(self) -> list[tuple[str, str]]:
+    def _graph(self, remote: list[GraphEntity]) -> list[tuple[str, str]]:
         out = [
             (name, t.typename)
             for name, t in list(self.context.graph.topics.items())
             if any(p.node is not self._node for p in t.publishers)
         ]
-        if self._remote_graph is not None:
-            out += [(e.topic, e.typename) for e in self._remote_graph() if e.kind == "publisher"]
+        out += [(e.topic, e.typename) for e in remote if e.kind == "publisher"]
         return out
 
     def _discover(self) -> None:
-        for topic, typename in self._graph():
+        remote = self._remote_graph() if self._remote_graph is not None else []
+        for topic, typename in self._graph(remote):
             if topic not in self._channels:
                 self.add_channel(topic, typename)
+        services = {
+            name: srv.srv_type.typename
+            for name, srv in list(self.context.graph.services.items())
+            if srv.node is not self._node
+        }
+        services.update({e.topic: e.typename for e in remote if e.kind == "service"})
+        gone = [name for name in self._services if name not in services]
+        if gone:
+            self.server.remove_services(gone)
+            for name in gone:
+                del self._services[name]
+        for name, typename in sorted(services.items()):
+            if name not in self._services:
+                self.add_service(name, typename)
 
     def _discovery_loop(self) -> None:
         while not self._stop.wait(_DISCOVERY_PERIOD_S):
@@ -113,6 +155,89 @@ class FoxgloveBridge(ServerListener):
         with self._lock:
             self._channels[topic] = (channel, typename)
             self._by_id[channel.id()] = topic
+
+    # ------------------------------------------------------------------ services
+    def add_service(self, name: str, typename: str) -> None:
+        """Advertise the service ``name`` (of type ``typename``) to Foxglove clients."""
+        try:
+            tname = normalize_type_name(typename)
+            parts = [
+                foxglove.MessageSchema(
+                    encoding="cdr",
+                    schema=foxglove.Schema(
+                        name=f"{tname}{suffix}",
+                        encoding="ros2msg",
+                        data=message_definition(f"{tname}{suffix}").encode(),
+                    ),
+                )
+                for suffix in ("_Request", "_Response")
+            ]
+        except RoverlabError:
+            return  # a type without a definition here cannot be called by clients
+        schema = foxglove.ServiceSchema(name=tname, request=parts[0], response=parts[1])
+        service = foxglove.Service(name, schema=schema, handler=self._service_handler(name, tname))
+        try:
+            self.server.add_services([service])
+        except Exception:  # already advertised (a race with the discovery thread)
+            return
+        self._services[name] = tname
+
+    def _service_handler(self, name: str, typename: str) -> Callable[[Any], bytes]:
+        empty = not message_definition(f"{typename}_Request").strip()
+
+        def handle(request: Any) -> bytes:
+            # runs on one of the SDK's threads: the call waits here, the executor serves it
+            try:
+                if request.encoding == "json":
+                    payload = from_dict(f"{typename}_Request", json.loads(request.payload))
+                elif empty and len(request.payload) <= 4:
+                    # a request without fields: Foxglove writes the CDR header alone
+                    payload = get_service_type(typename).Request()
+                else:
+                    payload = deserialize(request.payload, f"{typename}_Request")
+            except (RoverlabError, ValueError, struct.error) as err:
+                raise FoxgloveError(f"{name}: bad {request.encoding} request: {err}") from err
+            with self._lock:
+                client = self._service_clients.get(name)
+                if client is None:
+                    client = self._node.create_client(typename, name)
+                    self._service_clients[name] = client
+            if not client.wait_for_service(SERVICE_TIMEOUT_S):  # a new client learns servers
+                raise FoxgloveError(f"{name}: no server within {SERVICE_TIMEOUT_S:g} s")
+            try:
+                response = client.call(payload, timeout_sec=SERVICE_TIMEOUT_S)
+            except RoverlabError as err:
+                raise FoxgloveError(f"{name}: {err}") from err
+            if response is None:
+                raise FoxgloveError(f"{name}: no answer within {SERVICE_TIMEOUT_S:g} s")
+            return bytes(serialize(response))
+
+        return handle
+
+    @property
+    def services(self) -> list[str]:
+        """The services advertised to clients."""
+        return sorted(self._services)
+
+    # ------------------------------------------------------------------ parameters
+    def on_get_parameters(
+        self, client: Client, param_names: list[str], request_id: str | None = None
+    ) -> list[foxglove.Parameter]:
+        return self.parameters.get(param_names)
+
+    def on_set_parameters(
+        self,
+        client: Client,
+        parameters: list[foxglove.Parameter],
+        request_id: str | None = None,
+    ) -> list[foxglove.Parameter]:
+        for p in parameters:
+            try:
+                self.parameters.set(p.name, p.get_value())
+            except RoverlabError as err:
+                self.server.publish_status(str(err), foxglove.StatusLevel.Warning)
+        # the values now in force (a refused set shows the old value)
+        return self.parameters.get([p.name for p in parameters])
 
     # ------------------------------------------------------------------ ServerListener
     def on_subscribe(self, client: Client, channel: ChannelView) -> None:

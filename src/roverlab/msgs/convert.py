@@ -37,6 +37,7 @@ __all__ = [
     "image_to_array",
     "make_scan",
     "occupancy_grid_to_array",
+    "pointcloud2_field",
     "pointcloud2_to_rgb",
     "pointcloud2_to_xyz",
     "pose_from_xytheta",
@@ -474,6 +475,16 @@ def pointcloud2_to_xyz(pc: Any, *, skip_nans: bool = False) -> NDArray[np.float3
     if skip_nans:
         xyz = xyz[np.isfinite(xyz).all(axis=1)]
     return xyz
+
+
+def pointcloud2_field(pc: Any, name: str) -> NDArray[np.float64]:
+    """One point field of a ``sensor_msgs/PointCloud2`` (e.g. ``intensity``) as float64,
+    one value per point in row-major order.
+
+    Raises:
+        MessageValueError: No such field, or ``data`` too short.
+    """
+    return _read_fields(pc, (name,))[name].astype(np.float64)
 
 
 def pointcloud2_to_rgb(pc: Any) -> NDArray[np.uint8]:

@@ -29,6 +29,7 @@ import yaml
 
 from roverlab.errors import yaml_reason
 from roverlab.viz.errors import DashboardError
+from roverlab.viz.kinds import DISPLAY_KINDS, RVIZ_CLASSES, DisplayKind
 from roverlab.viz.views import check_view, default_view, view_from_rviz
 
 __all__ = [
@@ -52,161 +53,6 @@ _CONFIG_VERSION: Final = 1
 
 class ConfigError(DashboardError):
     """A display configuration (``.rviz`` or the dashboard's JSON) is malformed."""
-
-
-@dataclass(frozen=True)
-class DisplayKind:
-    """What one kind of display draws and how it is configured.
-
-    Attributes:
-        kind: the dashboard's name (``map``, ``laser_scan``, ...).
-        types: message types its topic may carry (empty: no topic).
-        default_topic: topic of a new display of this kind.
-        options: option name -> default value (its type is the default's type).
-    """
-
-    kind: str
-    types: tuple[str, ...]
-    default_topic: str
-    options: Mapping[str, Any]
-
-
-def _kind(kind: str, types: tuple[str, ...], topic: str, **options: Any) -> DisplayKind:
-    return DisplayKind(kind, types, topic, options)
-
-
-DISPLAY_KINDS: Final[dict[str, DisplayKind]] = {
-    k.kind: k
-    for k in (
-        _kind(
-            "grid",
-            (),
-            "",
-            cell_size=1.0,
-            cell_count=10,
-            color=[160, 160, 164],
-            alpha=0.5,
-            reference_frame="",
-        ),
-        _kind(
-            "map",
-            ("nav_msgs/msg/OccupancyGrid",),
-            "/map",
-            alpha=0.7,
-            color_scheme="map",
-            draw_behind=False,
-        ),
-        _kind(
-            "laser_scan",
-            ("sensor_msgs/msg/LaserScan",),
-            "/scan",
-            color=[255, 0, 0],
-            color_transformer="FlatColor",
-            size_px=3.0,
-            alpha=1.0,
-            decay_s=0.0,
-        ),
-        _kind("robot_model", (), "/robot_description", alpha=1.0),
-        _kind("tf", (), "", show_names=True, show_axes=True, scale=1.0),
-        _kind(
-            "odometry",
-            ("nav_msgs/msg/Odometry",),
-            "/odom",
-            keep=100,
-            color=[255, 25, 0],
-            alpha=1.0,
-            position_tolerance=0.1,
-            angle_tolerance=0.1,
-            length=1.3,
-        ),
-        _kind(
-            "path",
-            ("nav_msgs/msg/Path",),
-            "/move_base/NavfnROS/plan",
-            color=[25, 255, 0],
-            alpha=1.0,
-            line_width=0.03,
-        ),
-        _kind(
-            "pose_array",
-            ("geometry_msgs/msg/PoseArray",),
-            "/particlecloud",
-            color=[255, 25, 0],
-            alpha=1.0,
-            length=0.3,
-        ),
-        _kind(
-            "point_cloud2",
-            ("sensor_msgs/msg/PointCloud2",),
-            "/camera/depth/points",
-            color_transformer="AxisColor",
-            color=[255, 255, 255],
-            size_px=2.0,
-            alpha=1.0,
-            max_points=20000,
-            decay_s=0.0,
-        ),
-        _kind("marker", ("visualization_msgs/msg/Marker",), "/visualization_marker"),
-        _kind(
-            "marker_array",
-            ("visualization_msgs/msg/MarkerArray",),
-            "/visualization_marker_array",
-        ),
-        _kind(
-            "pose",
-            ("geometry_msgs/msg/PoseStamped",),
-            "/move_base_simple/goal",
-            color=[255, 25, 0],
-            alpha=1.0,
-            length=1.3,
-        ),
-        _kind(
-            "polygon",
-            ("geometry_msgs/msg/PolygonStamped",),
-            "/move_base/local_costmap/footprint",
-            color=[25, 255, 0],
-            alpha=1.0,
-        ),
-        _kind(
-            "pose_with_covariance",
-            ("geometry_msgs/msg/PoseWithCovarianceStamped",),
-            "/amcl_pose",
-            color=[255, 25, 0],
-            alpha=1.0,
-            length=1.0,
-            covariance_scale=1.0,
-        ),
-        _kind(
-            "image",
-            ("sensor_msgs/msg/Image", "sensor_msgs/msg/CompressedImage"),
-            "/image_raw",
-            color_map="jet",
-            min_value=0.0,
-            max_value=0.0,
-        ),
-    )
-}
-
-RVIZ_CLASSES: Final[dict[str, str]] = {
-    "rviz/Grid": "grid",
-    "rviz/Map": "map",
-    "rviz/LaserScan": "laser_scan",
-    "rviz/RobotModel": "robot_model",
-    "rviz/TF": "tf",
-    "rviz/Odometry": "odometry",
-    "rviz/Path": "path",
-    "rviz/PoseArray": "pose_array",
-    "rviz/PointCloud2": "point_cloud2",
-    "rviz/Marker": "marker",
-    "rviz/MarkerArray": "marker_array",
-    "rviz/Pose": "pose",
-    "rviz/PoseWithCovariance": "pose_with_covariance",
-    "rviz/Polygon": "polygon",
-    "rviz/PolygonStamped": "polygon",
-    "rviz/Image": "image",
-    "rviz/Camera": "image",
-}
-"""rviz display class -> dashboard display kind (rviz 2's ``rviz_default_plugins/X`` too)."""
 
 
 @dataclass
@@ -347,6 +193,7 @@ def _check_option(where: str, kind: str, name: str, value: Any) -> Any:
         "color_scheme": ("map", "costmap", "raw"),
         "color_map": ("gray", "jet", "hot", "rainbow"),
         "color_transformer": ("FlatColor", "Intensity", "AxisColor", "RGB8"),
+        "axis": ("X", "Y", "Z"),
     }.get(name)
     if choices and value not in choices:
         raise ConfigError(f"{where}: option {name!r} must be one of {', '.join(choices)}")
@@ -433,6 +280,40 @@ def _rviz_number(d: Mapping[str, Any], key: str, where: str) -> float | None:
         raise ConfigError(f"{where}: {key} must be a number, got {d[key]!r}") from None
 
 
+def _rviz_point_colours(d: Mapping[str, Any], opts: dict[str, Any], where: str) -> None:
+    """The Intensity and AxisColor transformers' properties of a LaserScan / PointCloud2."""
+    for key, opt in (("Min Intensity", "min_intensity"), ("Max Intensity", "max_intensity")):
+        value = _rviz_number(d, key, where)
+        if value is not None:
+            opts[opt] = value
+    flags = (
+        ("Autocompute Intensity Bounds", "autocompute_intensity_bounds"),
+        ("Use rainbow", "use_rainbow"),
+        ("Invert Rainbow", "invert_rainbow"),
+        ("Use Fixed Frame", "use_fixed_frame"),
+    )
+    for key, opt in flags:
+        if key in d:
+            opts[opt] = bool(d[key])
+    for key, opt in (("Min Color", "min_color"), ("Max Color", "max_color")):
+        if key in d:
+            opts[opt] = _rviz_color(d[key], where)
+    if "Channel Name" in d:
+        opts["channel_name"] = str(d["Channel Name"])
+    if "Axis" in d:
+        opts["axis"] = str(d["Axis"])
+    bounds = d.get("Autocompute Value Bounds")  # rviz 1: {Value, Min Value, Max Value}
+    if isinstance(bounds, Mapping):
+        if "Value" in bounds:
+            opts["autocompute_value_bounds"] = bool(bounds["Value"])
+        for key, opt in (("Min Value", "min_value"), ("Max Value", "max_value")):
+            value = _rviz_number(bounds, key, where)
+            if value is not None:
+                opts[opt] = value
+    elif bounds is not None:
+        opts["autocompute_value_bounds"] = bool(bounds)
+
+
 def _rviz_display(d: Mapping[str, Any], kind: str, where: str) -> DisplayConfig:
     opts: dict[str, Any] = {}
 
@@ -461,6 +342,7 @@ def _rviz_display(d: Mapping[str, Any], kind: str, where: str) -> DisplayConfig:
         num("Size (Pixels)", "size_px")
         if "Color Transformer" in d:
             opts["color_transformer"] = str(d["Color Transformer"])
+        _rviz_point_colours(d, opts, where)
     elif kind == "robot_model":
         topic = "/" + str(d.get("Robot Description", "robot_description")).lstrip("/")
     elif kind == "tf":

@@ -4,20 +4,20 @@ Nothing here touches the bus or a clock: functions take arrays, message objects 
 :class:`~roverlab.geometry.Transform3` poses (``fixed_from_frame``) and return arrays or
 small JSON-able dicts in the fixed frame, seen from above.
 
-* :func:`color_buckets` / :func:`decimate`: point colours (rviz's ``AxisColor`` rainbow
-  by height, ``Intensity``, ``FlatColor``) as a few colour buckets, and server-side
-  thinning of big clouds;
+* :func:`decimate`: server-side thinning of big clouds (the colours:
+  :mod:`roverlab.viz.colours`, :func:`color_buckets` re-exported here);
 * :class:`PoseTrail`: rviz's Odometry display (keep N arrows, position/angle tolerance);
 * :func:`map_change`: the window of cells that changed between two maps;
 * :func:`marker_primitives` and :class:`MarkerStore`: ``visualization_msgs/Marker``
   (ARROW, CUBE, SPHERE, CYLINDER, LINE_STRIP, LINE_LIST, CUBE_LIST, SPHERE_LIST, POINTS,
-  TEXT_VIEW_FACING; ADD, DELETE, DELETEALL, lifetime, frame_locked) as 2-D primitives.
+  TEXT_VIEW_FACING; ADD, DELETE, DELETEALL, lifetime, frame_locked) as 2-D primitives,
+  and :func:`marker_3d`: the same markers whole for the 3D view (TRIANGLE_LIST too).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Final
 
@@ -25,7 +25,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from roverlab.geometry import Transform3, quat_rotate, wrap_angle, yaw_from_quat
-from roverlab.viz.protocol import convex_hull, rainbow
+from roverlab.viz.colours import color_buckets
+from roverlab.viz.protocol import convex_hull
 
 __all__ = [
     "MARKER_ARROW",
@@ -35,9 +36,12 @@ __all__ = [
     "color_buckets",
     "decimate",
     "map_change",
+    "marker_3d",
     "marker_primitives",
     "pose_covariance_primitives",
+    "poses3_in_fixed",
     "poses_in_fixed",
+    "yaw_of_poses3",
 ]
 
 MARKER_ARROW: Final = 0
@@ -53,7 +57,6 @@ MARKER_TEXT: Final = 9
 ACTION_ADD: Final = 0
 ACTION_DELETE: Final = 2
 ACTION_DELETEALL: Final = 3
-_BUCKETS: Final = 32
 _RING: Final = 24
 
 
@@ -65,34 +68,6 @@ def decimate(points: NDArray[Any], max_points: int) -> NDArray[Any]:
         return points
     step = math.ceil(n / max_points)
     return points[::step]
-
-
-def color_buckets(
-    transformer: str,
-    *,
-    count: int,
-    flat_rgb: tuple[int, int, int] | list[int],
-    alpha: float,
-    values: NDArray[Any] | None = None,
-    buckets: int = _BUCKETS,
-) -> tuple[NDArray[np.int64] | None, NDArray[np.uint8]]:
-    """Bucket index per point and an RGBA palette, as :func:`encode_points` wants.
-
-    ``FlatColor`` (or no ``values``): one bucket of ``flat_rgb``. ``AxisColor`` /
-    ``Intensity``: ``values`` (height in the fixed frame, or intensity) scaled from their
-    finite minimum..maximum onto rviz's rainbow in ``buckets`` steps.
-    """
-    a = int(round(max(0.0, min(1.0, alpha)) * 255))
-    if transformer == "FlatColor" or values is None or count == 0:
-        return None, np.array([[*flat_rgb, a]], dtype=np.uint8)
-    v = np.asarray(values, dtype=np.float64).reshape(-1)
-    finite = np.isfinite(v)
-    lo, hi = (float(v[finite].min()), float(v[finite].max())) if finite.any() else (0.0, 1.0)
-    span = hi - lo if hi > lo else 1.0
-    idx = np.clip(((np.where(finite, v, lo) - lo) / span * (buckets - 1)).round(), 0, buckets - 1)
-    rgb = (rainbow(np.linspace(0.0, 1.0, buckets)) * 255.0 + 0.5).astype(np.uint8)
-    palette = np.column_stack((rgb, np.full(buckets, a, dtype=np.uint8)))
-    return idx.astype(np.int64), palette
 
 
 def poses_in_fixed(
@@ -110,6 +85,39 @@ def poses_in_fixed(
     )
     heading = quat_rotate(fixed_from_frame.rotation, axis).reshape(-1, 3)
     return np.column_stack((pos[:, :2], np.arctan2(heading[:, 1], heading[:, 0])))
+
+
+def poses3_in_fixed(
+    fixed_from_frame: Transform3,
+    positions: NDArray[np.floating[Any]],
+    quats_xyzw: NDArray[np.floating[Any]],
+) -> NDArray[np.float64]:
+    """``(N, 7)`` ``(x, y, z, qx, qy, qz, qw)`` in the fixed frame of poses given in a
+    frame: the full 3-D pose (a zero quaternion counts as the identity, as rviz)."""
+    pos = fixed_from_frame.apply(np.asarray(positions, dtype=np.float64).reshape(-1, 3))
+    q = np.asarray(quats_xyzw, dtype=np.float64).reshape(-1, 4)
+    norm = np.linalg.norm(q, axis=1, keepdims=True)
+    ok = np.isfinite(norm) & (norm > 1e-12)
+    q = np.where(ok, q / np.where(ok, norm, 1.0), np.array([0.0, 0.0, 0.0, 1.0]))
+    ax, ay, az, aw = (float(v) for v in fixed_from_frame.rotation)
+    bx, by, bz, bw = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
+    out = np.column_stack(
+        (
+            pos,
+            aw * bx + ax * bw + ay * bz - az * by,
+            aw * by - ax * bz + ay * bw + az * bx,
+            aw * bz + ax * by - ay * bx + az * bw,
+            aw * bw - ax * bx - ay * by - az * bz,
+        )
+    )
+    return out
+
+
+def yaw_of_poses3(poses: NDArray[np.floating[Any]]) -> NDArray[np.float64]:
+    """The heading (yaw of the x axis seen from above) of ``(N, 7)`` poses."""
+    q = np.asarray(poses, dtype=np.float64).reshape(-1, 7)[:, 3:]
+    x, y, z, w = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
+    return np.arctan2(2.0 * (x * y + w * z), 1.0 - 2.0 * (y * y + z * z))
 
 
 def pose_covariance_primitives(
@@ -170,30 +178,41 @@ class PoseTrail:
     """rviz's Odometry display: the last ``keep`` poses, a new one kept only when it moved
     more than ``position_tolerance_m`` or turned more than ``angle_tolerance_rad``.
 
-    ``keep`` 0 keeps every pose (rviz: unlimited).
+    ``keep`` 0 keeps every pose (rviz: unlimited). Poses are ``(x, y, yaw)``, or full
+    ``(x, y, z, qx, qy, qz, qw)`` rows given as ``full`` (then :meth:`array3` has them).
     """
 
     keep: int = 100
     position_tolerance_m: float = 0.1
     angle_tolerance_rad: float = 0.1
     poses: list[tuple[float, float, float]] = field(default_factory=list)
+    full: list[tuple[float, ...]] = field(default_factory=list)
 
-    def add(self, x: float, y: float, yaw: float) -> bool:
+    def add(self, x: float, y: float, yaw: float, full: Sequence[float] | None = None) -> bool:
         """Consider a pose; True if it was kept."""
         if self.poses:
             lx, ly, lyaw = self.poses[-1]
             moved = math.hypot(x - lx, y - ly) > self.position_tolerance_m
+            if full is not None and self.full:
+                moved = moved or abs(float(full[2]) - self.full[-1][2]) > self.position_tolerance_m
             turned = abs(wrap_angle(yaw - lyaw)) > self.angle_tolerance_rad
             if not (moved or turned):
                 return False
         self.poses.append((x, y, yaw))
+        self.full.append(tuple(float(v) for v in full) if full is not None else
+                         (x, y, 0.0, 0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2)))  # fmt: skip
         if self.keep > 0 and len(self.poses) > self.keep:
             del self.poses[: len(self.poses) - self.keep]
+            del self.full[: len(self.full) - self.keep]
         return True
 
     def array(self) -> NDArray[np.float64]:
-        """The kept poses, ``(N, 3)``."""
+        """The kept poses, ``(N, 3)`` ``(x, y, yaw)``."""
         return np.array(self.poses, dtype=np.float64).reshape(-1, 3)
+
+    def array3(self) -> NDArray[np.float64]:
+        """The kept poses, ``(N, 7)`` ``(x, y, z, qx, qy, qz, qw)``."""
+        return np.array(self.full, dtype=np.float64).reshape(-1, 7)
 
 
 # ------------------------------------------------------------------------- map
@@ -338,12 +357,43 @@ def marker_primitives(marker: Any, fixed_from_frame: Transform3) -> list[dict[st
     return [prim]
 
 
+MARKER_TRIANGLE_LIST: Final = 11
+
+
+def marker_3d(marker: Any, fixed_from_frame: Transform3) -> dict[str, Any]:
+    """A marker as the 3D view draws it: its type, pose in the fixed frame (``[x, y, z,
+    qx, qy, qz, qw]``, the orientation in full), scale, colour, and its ``points`` /
+    ``colors`` (in the marker's own pose) and ``text`` when it has them."""
+    p, q = marker.pose.position, marker.pose.orientation
+    pose = poses3_in_fixed(
+        fixed_from_frame,
+        np.array([[p.x, p.y, p.z]], dtype=np.float64),
+        np.array([[q.x, q.y, q.z, q.w]], dtype=np.float64),
+    )[0]
+    out: dict[str, Any] = {
+        "ns": str(marker.ns),
+        "id": int(marker.id),
+        "type": int(marker.type),
+        "pose": [round(float(v), 6) for v in pose],
+        "scale": [round(float(v), 6) for v in (marker.scale.x, marker.scale.y, marker.scale.z)],
+        "rgba": _rgba(marker.color),
+    }
+    if len(marker.points):
+        out["points"] = np.round(_points(marker.points), 6).tolist()
+        if len(marker.colors) == len(marker.points):
+            out["colors"] = [_rgba(c) for c in marker.colors]
+    if int(marker.type) == MARKER_TEXT:
+        out["text"] = str(marker.text)
+    return out
+
+
 @dataclass
 class _Entry:
     marker: Any
     frame: str
     expires_ns: int | None
     primitives: list[dict[str, Any]]
+    solid: dict[str, Any]
 
 
 class MarkerStore:
@@ -383,7 +433,9 @@ class MarkerStore:
         self.errors.pop(f"{key[0]}/{key[1]}", None)
         life = int(marker.lifetime.sec) * 1_000_000_000 + int(marker.lifetime.nanosec)
         expires = now_ns + life if life > 0 else None
-        self._entries[key] = _Entry(marker, frame, expires, marker_primitives(marker, tf))
+        self._entries[key] = _Entry(
+            marker, frame, expires, marker_primitives(marker, tf), marker_3d(marker, tf)
+        )
         return True
 
     def refresh(self, now_ns: int) -> bool:
@@ -397,6 +449,7 @@ class MarkerStore:
                 tf = self._lookup(entry.frame)
                 if tf is not None:
                     entry.primitives = marker_primitives(entry.marker, tf)
+                    entry.solid = marker_3d(entry.marker, tf)
                     changed = True
         return changed
 
@@ -406,6 +459,10 @@ class MarkerStore:
         for key in sorted(self._entries):
             out.extend(self._entries[key].primitives)
         return out
+
+    def solids(self) -> list[dict[str, Any]]:
+        """Every marker as :func:`marker_3d` gives it, in ``(ns, id)`` order."""
+        return [self._entries[key].solid for key in sorted(self._entries)]
 
 
 def yaw_of(q: Any) -> float:

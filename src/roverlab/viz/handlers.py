@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any, ClassVar, Final, Protocol
 
@@ -21,6 +21,7 @@ from roverlab.core import Context, Time
 from roverlab.geometry import Transform3
 from roverlab.msgs import (
     occupancy_grid_to_array,
+    pointcloud2_field,
     pointcloud2_to_rgb,
     pointcloud2_to_xyz,
     scan_to_points,
@@ -31,10 +32,11 @@ from roverlab.viz.displays import (
     MarkerStore,
     PoseTrail,
     color_buckets,
-    decimate,
     map_change,
     pose_covariance_primitives,
+    poses3_in_fixed,
     poses_in_fixed,
+    yaw_of_poses3,
 )
 from roverlab.viz.protocol import (
     encode_map,
@@ -147,6 +149,8 @@ class DisplayHandler:
         return True
 
     def posed(self, state: DisplayState, header: Any, poses: Sequence[Any]) -> np.ndarray | None:
+        """``(N, 7)`` full poses in the fixed frame (None, with the TF status, if TF cannot
+        say)."""
         tf, why = self.bridge.lookup_why(str(header.frame_id), stamp_time(header))
         if not self.tf_status(state, tf, why):
             return None
@@ -156,13 +160,14 @@ class DisplayHandler:
             [(p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w) for p in poses],
             dtype=float,
         )
-        return poses_in_fixed(tf, pos.reshape(-1, 3), quat.reshape(-1, 4))
+        return poses3_in_fixed(tf, pos.reshape(-1, 3), quat.reshape(-1, 4))
 
 
 def markers_changed(bridge: BridgeLike, state: DisplayState) -> None:
     """A marker display's primitives changed: a new frame, and the marker TF status."""
     assert state.markers is not None
-    state.frame = Versioned(bridge.next_version(), json.dumps(state.markers.primitives()))
+    payload = {"items": state.markers.primitives(), "items3d": state.markers.solids()}
+    state.frame = Versioned(bridge.next_version(), json.dumps(payload))
     errors = state.markers.errors
     if errors:
         name, why = next(iter(errors.items()))
@@ -207,38 +212,83 @@ class MapDisplay(DisplayHandler):
         state.frame = frame
 
 
+_AXES: Final = {"X": 0, "Y": 1, "Z": 2}
+
+
+def _colours(
+    state: DisplayState,
+    world: np.ndarray,
+    local: np.ndarray,
+    channel: Callable[[str], np.ndarray | None],
+) -> tuple[np.ndarray | None, np.ndarray]:
+    """Bucket indices and palette of a LaserScan / PointCloud2 display's points: the
+    configured colour transformer over ``channel(name)`` (Intensity) or a coordinate
+    (AxisColor, of ``world`` or ``local``); bounds used go into the display's info."""
+    cfg = state.config
+    transformer = str(cfg.option("color_transformer"))
+    values: np.ndarray | None = None
+    if transformer == "Intensity":
+        name = str(cfg.option("channel_name"))
+        values = channel(name)
+        if values is None and name == "intensity":  # rviz: 'intensity' also finds 'intensities'
+            values = channel("intensities")
+        if values is None:
+            state.status["Color Transformer"] = ("warn", f"no channel {name!r}: drawn flat")
+        else:
+            state.status["Color Transformer"] = ("ok", f"Intensity of {name!r}")
+    else:
+        state.status.pop("Color Transformer", None)
+    if transformer == "AxisColor":
+        frame = world if bool(cfg.option("use_fixed_frame")) else local
+        values = frame[:, _AXES[str(cfg.option("axis"))]] if len(frame) else None
+    idx, palette, bounds = color_buckets(
+        transformer,
+        count=len(world),
+        flat_rgb=rgb_option(cfg),
+        alpha=float(cfg.option("alpha")),
+        values=values,
+        option=cfg.option,
+    )
+    if bounds is not None:
+        state.info["bounds"] = [round(bounds[0], 6), round(bounds[1], 6)]
+    return idx, palette
+
+
 class LaserScanDisplay(DisplayHandler):
-    """rviz/LaserScan: the beams as 3-D points in the fixed frame, at the laser's height."""
+    """rviz/LaserScan: the beams as 3-D points in the fixed frame, at the laser's height,
+    coloured by a transformer (channels ``intensity`` and ``index``, as laser_geometry's
+    projection gives rviz)."""
 
     kind = "laser_scan"
 
     def on_message(self, state: DisplayState, msg: Any) -> None:
-        cfg = state.config
         tf, why = self.bridge.lookup_why(str(msg.header.frame_id), stamp_time(msg.header))
         if not self.tf_status(state, tf, why):
             return
         assert tf is not None
-        pts = scan_to_points(msg)
-        world = tf.apply(np.column_stack((pts, np.zeros(len(pts)))))  # at the laser's height
-        values = None
-        if cfg.option("color_transformer") == "Intensity" and len(msg.intensities) > 0:
-            rng = np.asarray(msg.ranges, dtype=np.float64)
+        rng = np.asarray(msg.ranges, dtype=np.float64)
+        with np.errstate(invalid="ignore"):
             ok = np.isfinite(rng) & (rng >= msg.range_min) & (rng <= msg.range_max)
+        pts = scan_to_points(msg)
+        local = np.column_stack((pts, np.zeros(len(pts))))
+        world = tf.apply(local)  # at the laser's height
+
+        def channel(name: str) -> np.ndarray | None:
+            if name == "index":
+                return np.flatnonzero(ok).astype(np.float64)
             inten = np.asarray(msg.intensities, dtype=np.float64)
-            if len(inten) == len(rng):
-                values = inten[ok]
-        idx, palette = color_buckets(
-            str(cfg.option("color_transformer")),
-            count=len(world),
-            flat_rgb=rgb_option(cfg),
-            alpha=float(cfg.option("alpha")),
-            values=values if values is not None and len(values) == len(world) else None,
-        )
+            if name in ("intensity", "intensities") and len(inten) == len(rng) > 0:
+                found: np.ndarray = inten[ok]
+                return found
+            return None
+
+        idx, palette = _colours(state, world, local, channel)
         state.frame = Versioned(self.bridge.next_version(), encode_points(world, idx, palette))
 
 
 class PointCloud2Display(DisplayHandler):
-    """rviz/PointCloud2: points in 3-D, RGB8 per point or rainbow buckets, thinned to Max Points."""
+    """rviz/PointCloud2: points in 3-D, RGB8 per point or a colour transformer over a
+    channel / coordinate, thinned to Max Points."""
 
     kind = "point_cloud2"
 
@@ -250,34 +300,32 @@ class PointCloud2Display(DisplayHandler):
         assert tf is not None
         transformer = str(cfg.option("color_transformer"))
         names = {f.name for f in msg.fields}
+        xyz_all = pointcloud2_to_xyz(msg)
+        keep = np.isfinite(xyz_all).all(axis=1)
+        step = max(1, math.ceil(int(keep.sum()) / max(1, int(cfg.option("max_points")))))
+        local = xyz_all[keep][::step].astype(np.float64)
+        world = tf.apply(local)
+        state.info = {"points": len(world)}
         if transformer == "RGB8" and ("rgb" in names or "rgba" in names):
-            xyz_all = pointcloud2_to_xyz(msg)
-            keep = np.isfinite(xyz_all).all(axis=1)
-            step = max(1, math.ceil(int(keep.sum()) / max(1, int(cfg.option("max_points")))))
-            xyz = xyz_all[keep][::step]
             colours = pointcloud2_to_rgb(msg)[keep][::step]
-            world = tf.apply(xyz.astype(np.float64))
             alpha = round(max(0.0, min(1.0, float(cfg.option("alpha")))) * 255)
-            state.info = {"points": len(world)}
             frame = encode_points(world, None, [[255, 255, 255, alpha]], rgb=colours)
             state.frame = Versioned(self.bridge.next_version(), frame)
             return
-        xyz = pointcloud2_to_xyz(msg, skip_nans=True)
-        xyz = decimate(xyz, int(cfg.option("max_points")))
-        world = tf.apply(xyz.astype(np.float64))
-        idx, palette = color_buckets(
-            str(cfg.option("color_transformer")),
-            count=len(world),
-            flat_rgb=rgb_option(cfg),
-            alpha=float(cfg.option("alpha")),
-            values=world[:, 2],
-        )
-        state.info = {"points": len(world)}
+
+        def channel(name: str) -> np.ndarray | None:
+            if name not in names:
+                return None
+            values: np.ndarray = pointcloud2_field(msg, name)[keep][::step]
+            return values
+
+        idx, palette = _colours(state, world, local, channel)
         state.frame = Versioned(self.bridge.next_version(), encode_points(world, idx, palette))
 
 
 class OdometryDisplay(DisplayHandler):
-    """rviz/Odometry: a trail of arrows (keep, position and angle tolerance)."""
+    """rviz/Odometry: a trail of arrows (keep, position and angle tolerance), full 3-D
+    poses."""
 
     kind = "odometry"
 
@@ -285,12 +333,13 @@ class OdometryDisplay(DisplayHandler):
         arr = self.posed(state, msg.header, [msg.pose.pose])
         if arr is None or state.trail is None:
             return
-        if state.trail.add(float(arr[0, 0]), float(arr[0, 1]), float(arr[0, 2])):
-            state.frame = Versioned(self.bridge.next_version(), encode_poses(state.trail.array()))
+        yaw = float(yaw_of_poses3(arr)[0])
+        if state.trail.add(float(arr[0, 0]), float(arr[0, 1]), yaw, arr[0]):
+            state.frame = Versioned(self.bridge.next_version(), encode_poses(state.trail.array3()))
 
 
 class PathDisplay(DisplayHandler):
-    """rviz/Path: the poses' positions as a line."""
+    """rviz/Path: the poses' positions as a line, at their heights."""
 
     kind = "path"
 
@@ -298,11 +347,11 @@ class PathDisplay(DisplayHandler):
         arr = self.posed(state, msg.header, [p.pose for p in msg.poses])
         if arr is None:
             return
-        state.frame = Versioned(self.bridge.next_version(), encode_path(arr[:, :2]))
+        state.frame = Versioned(self.bridge.next_version(), encode_path(arr[:, :3]))
 
 
 class PoseArrayDisplay(DisplayHandler):
-    """rviz/PoseArray: one arrow per pose."""
+    """rviz/PoseArray: one arrow per pose, fully oriented."""
 
     kind = "pose_array"
 
@@ -314,7 +363,7 @@ class PoseArrayDisplay(DisplayHandler):
 
 
 class PoseDisplay(DisplayHandler):
-    """rviz/Pose: one arrow."""
+    """rviz/Pose: one arrow, fully oriented."""
 
     kind = "pose"
 
@@ -349,7 +398,7 @@ class PoseWithCovarianceDisplay(DisplayHandler):
             float(cov[5, 5]), rgb=rgb_option(cfg), alpha=float(cfg.option("alpha")),
             length=float(cfg.option("length")), scale=float(cfg.option("covariance_scale")),
         )  # fmt: skip
-        state.frame = Versioned(self.bridge.next_version(), json.dumps(items))
+        state.frame = Versioned(self.bridge.next_version(), json.dumps({"items": items}))
 
 
 class PolygonDisplay(DisplayHandler):
@@ -371,7 +420,7 @@ class PolygonDisplay(DisplayHandler):
             rgba = [r / 255.0, g / 255.0, b / 255.0, float(state.config.option("alpha"))]
             items.append({"shape": "polyline", "rgba": rgba, "width": 0.0,
                           "points": [*xy, xy[0]]})  # fmt: skip
-        state.frame = Versioned(self.bridge.next_version(), json.dumps(items))
+        state.frame = Versioned(self.bridge.next_version(), json.dumps({"items": items}))
 
 
 class MarkerDisplay(DisplayHandler):

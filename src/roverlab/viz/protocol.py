@@ -15,8 +15,10 @@ that follow 4-byte aligned in the browser). All numbers are little-endian:
   flag :data:`POINTS_XYZ` ``(x, y, z)`` triples, with :data:`POINTS_RGB` then ``count``
   RGBA u8 colours, one per point (rviz's RGB8);
 * :data:`KIND_POSES` (odometry, pose arrays, poses): ``<u32 count>`` then ``count`` float32
-  ``(x, y, yaw)`` in the fixed frame;
+  ``(x, y, yaw)`` in the fixed frame; with flag :data:`POSES_3D` ``(x, y, z, qx, qy, qz,
+  qw)``, the full pose (the page derives the top view's yaw);
 * :data:`KIND_PATH`: ``<u32 count>`` then ``count`` float32 ``(x, y)`` in the fixed frame;
+  with flag :data:`PATH_XYZ` ``(x, y, z)``;
 * :data:`KIND_IMAGE`: a JPEG (``flags`` 0) or PNG (``flags`` 1) file.
 
 Everything else (markers, the robot's projected outline, frames, statuses, topic lists)
@@ -51,8 +53,10 @@ __all__ = [
     "KIND_POINTS",
     "KIND_POSES",
     "KIND_SCAN",
+    "PATH_XYZ",
     "POINTS_RGB",
     "POINTS_XYZ",
+    "POSES_3D",
     "VisualOutline",
     "VisualShape",
     "colorize",
@@ -80,6 +84,8 @@ KIND_PATH: Final = 5
 KIND_MAP_PATCH: Final = 6
 POINTS_XYZ: Final = 1
 POINTS_RGB: Final = 2
+POSES_3D: Final = 1
+PATH_XYZ: Final = 1
 IMAGE_JPEG: Final = 0
 IMAGE_PNG: Final = 1
 
@@ -165,16 +171,24 @@ def encode_scan(points_xy: NDArray[np.floating[Any]], *, slot: int = 0) -> bytes
     return encode_points(points_xy, slot=slot)
 
 
-def encode_poses(poses_xyyaw: NDArray[np.floating[Any]], *, slot: int = 0) -> bytes:
-    """A :data:`KIND_POSES` frame for ``(N, 3)`` ``(x, y, yaw)`` in the fixed frame."""
-    arr = np.ascontiguousarray(poses_xyyaw, dtype="<f4").reshape(-1, 3)
-    return struct.pack("<BBHI", KIND_POSES, 0, slot, len(arr)) + arr.tobytes()
+def encode_poses(poses: NDArray[np.floating[Any]], *, slot: int = 0) -> bytes:
+    """A :data:`KIND_POSES` frame for ``(N, 3)`` ``(x, y, yaw)`` or ``(N, 7)`` ``(x, y, z,
+    qx, qy, qz, qw)`` poses in the fixed frame (flag :data:`POSES_3D`)."""
+    raw = np.asarray(poses, dtype=np.float64)
+    width = 7 if raw.ndim == 2 and raw.shape[1] == 7 else 3
+    arr = np.ascontiguousarray(raw, dtype="<f4").reshape(-1, width)
+    flags = POSES_3D if width == 7 else 0
+    return struct.pack("<BBHI", KIND_POSES, flags, slot, len(arr)) + arr.tobytes()
 
 
-def encode_path(points_xy: NDArray[np.floating[Any]], *, slot: int = 0) -> bytes:
-    """A :data:`KIND_PATH` frame for an ``(N, 2)`` polyline in the fixed frame, m."""
-    arr = np.ascontiguousarray(points_xy, dtype="<f4").reshape(-1, 2)
-    return struct.pack("<BBHI", KIND_PATH, 0, slot, len(arr)) + arr.tobytes()
+def encode_path(points: NDArray[np.floating[Any]], *, slot: int = 0) -> bytes:
+    """A :data:`KIND_PATH` frame for an ``(N, 2)`` or ``(N, 3)`` (flag :data:`PATH_XYZ`)
+    polyline in the fixed frame, m."""
+    raw = np.asarray(points, dtype=np.float64)
+    width = 3 if raw.ndim == 2 and raw.shape[1] == 3 else 2
+    arr = np.ascontiguousarray(raw, dtype="<f4").reshape(-1, width)
+    flags = PATH_XYZ if width == 3 else 0
+    return struct.pack("<BBHI", KIND_PATH, flags, slot, len(arr)) + arr.tobytes()
 
 
 def _lut(name: str) -> NDArray[np.uint8]:

@@ -294,8 +294,9 @@ class DashboardServer:
             return
         sent[key] = item.version
         if isinstance(item.payload, str):
+            # the payload is a JSON object {"items": [...], ...}: merged into the message
             await websocket.send_text(
-                f'{{"type": "markers", "slot": {d.slot}, "items": {item.payload}}}'
+                f'{{"type": "markers", "slot": {d.slot}, {item.payload.lstrip()[1:]}'
             )
         else:
             await websocket.send_bytes(self._slotted(item.payload, d.slot))

@@ -12,6 +12,7 @@
     color_scheme: ["map", "costmap", "raw"],
     color_map: ["gray", "jet", "hot", "rainbow"],
     color_transformer: ["FlatColor", "Intensity", "AxisColor", "RGB8"],
+    axis: ["X", "Y", "Z"],
   };
   const KIND_TYPES = {
     map: ["nav_msgs/msg/OccupancyGrid"], laser_scan: ["sensor_msgs/msg/LaserScan"],
@@ -167,6 +168,8 @@
       paintMap(m, m.scheme, x0, y0, w, h);
       m.version = (m.version || 0) + 1;
       m.dirty = m.dirty ? [Math.min(m.dirty[0], x0), Math.min(m.dirty[1], y0), Math.max(m.dirty[2], x0 + w), Math.max(m.dirty[3], y0 + h)] : [x0, y0, x0 + w, y0 + h];
+      const d3 = m.dirty3;  // the same for the 3D view's map levels (it clears its own)
+      m.dirty3 = d3 ? [Math.min(d3[0], x0), Math.min(d3[1], y0), Math.max(d3[2], x0 + w), Math.max(d3[3], y0 + h)] : [x0, y0, x0 + w, y0 + h];
     } else if (kind === KIND_POINTS) {
       // flags: 1 = (x, y, z) triples, 2 = one RGBA colour per point after the points
       const n = dv.getUint32(4, true), nb = dv.getUint32(8, true);
@@ -199,12 +202,26 @@
       L.points = keep;
       L.version = (L.version || 0) + 1;
     } else if (kind === KIND_POSES) {
+      // flag 1: full poses (x, y, z, qx, qy, qz, qw) for the 3D view; the top view's yaw
       const n = dv.getUint32(4, true);
-      L.poses = new Float32Array(buf, 8, n * 3);
+      if (flags & 1) {
+        const p7 = new Float32Array(buf, 8, n * 7), p3 = new Float32Array(n * 3);
+        for (let i = 0; i < n; i++) {
+          const x = p7[7 * i + 3], y = p7[7 * i + 4], z = p7[7 * i + 5], w = p7[7 * i + 6];
+          p3[3 * i] = p7[7 * i]; p3[3 * i + 1] = p7[7 * i + 1];
+          p3[3 * i + 2] = Math.atan2(2 * (x * y + w * z), 1 - 2 * (y * y + z * z));
+        }
+        L.poses = p3; L.poses3 = p7;
+      } else { L.poses = new Float32Array(buf, 8, n * 3); L.poses3 = null; }
       L.version = (L.version || 0) + 1;
     } else if (kind === KIND_PATH) {
+      // flag 1: (x, y, z) points
       const n = dv.getUint32(4, true);
-      L.path = new Float32Array(buf, 8, n * 2);
+      if (flags & 1) {
+        const p3 = new Float32Array(buf, 8, n * 3), p2 = new Float32Array(n * 2);
+        for (let i = 0; i < n; i++) { p2[2 * i] = p3[3 * i]; p2[2 * i + 1] = p3[3 * i + 1]; }
+        L.path = p2; L.path3 = p3;
+      } else { L.path = new Float32Array(buf, 8, n * 2); L.path3 = null; }
       L.version = (L.version || 0) + 1;
     } else if (kind === KIND_IMAGE) {
       const mime = flags === 1 ? "image/png" : "image/jpeg";
@@ -219,7 +236,7 @@
   function onText(msg) {
     if (msg.type === "state") onState(msg);
     else if (msg.type === "config") onConfig(msg.config);
-    else if (msg.type === "markers") layer(msg.slot).markers = msg.items;
+    else if (msg.type === "markers") { const l = layer(msg.slot); l.markers = msg.items; l.markers3d = msg.items3d || null; }
     else if (msg.type === "notice") {
       noticeEl.textContent = msg.text; noticeEl.className = msg.level === "error" ? "error" : "";
     }
@@ -379,15 +396,20 @@
     if (key === "color_scheme" && L && L.map) paintMap(L.map, d.options.color_scheme, 0, 0, L.map.w, L.map.h);
   }
 
+  const POINT_COLOURS = {  // rviz's Intensity and AxisColor transformers (defaults as rviz)
+    channel_name: "intensity", autocompute_intensity_bounds: true, min_intensity: 0.0, max_intensity: 4096.0,
+    use_rainbow: true, invert_rainbow: false, min_color: [0, 0, 0], max_color: [255, 255, 255],
+    axis: "Z", autocompute_value_bounds: true, min_value: -10.0, max_value: 10.0, use_fixed_frame: true,
+  };
   const DEFAULT_OPTIONS = {
     grid: { cell_size: 1.0, cell_count: 10, color: [160, 160, 164], alpha: 0.5, reference_frame: "" },
     map: { alpha: 0.7, color_scheme: "map", draw_behind: false },
-    laser_scan: { color: [255, 0, 0], color_transformer: "FlatColor", size_px: 3.0, alpha: 1.0, decay_s: 0.0 },
+    laser_scan: { color: [255, 0, 0], color_transformer: "FlatColor", size_px: 3.0, alpha: 1.0, decay_s: 0.0, ...POINT_COLOURS },
     robot_model: { alpha: 1.0 }, tf: { show_names: true, show_axes: true, scale: 1.0 },
     odometry: { keep: 100, color: [255, 25, 0], alpha: 1.0, position_tolerance: 0.1, angle_tolerance: 0.1, length: 1.3 },
     path: { color: [25, 255, 0], alpha: 1.0, line_width: 0.03 },
     pose_array: { color: [255, 25, 0], alpha: 1.0, length: 0.3 },
-    point_cloud2: { color_transformer: "AxisColor", color: [255, 255, 255], size_px: 2.0, alpha: 1.0, max_points: 20000, decay_s: 0.0 },
+    point_cloud2: { color_transformer: "AxisColor", color: [255, 255, 255], size_px: 2.0, alpha: 1.0, max_points: 20000, decay_s: 0.0, ...POINT_COLOURS },
     marker: {}, marker_array: {}, pose: { color: [255, 25, 0], alpha: 1.0, length: 1.3 },
     pose_with_covariance: { color: [255, 25, 0], alpha: 1.0, length: 1.0, covariance_scale: 1.0 },
     polygon: { color: [25, 255, 0], alpha: 1.0 },

@@ -4,6 +4,7 @@
 import * as THREE from "three";
 import { STLLoader } from "./vendor/three/addons/loaders/STLLoader.js";
 import { ColladaLoader } from "./vendor/three/addons/loaders/ColladaLoader.js";
+import { buildMarker, markerShapeKey, setLineResolution } from "./markers3d.js";
 
 const viz = window.viz;
 const data = viz.data;
@@ -48,7 +49,13 @@ function setMode(mode) {
   canvas.style.display = is3d ? "block" : "none";
   labels.style.display = is3d ? "block" : "none";
   canvas2d.style.display = is3d ? "none" : "block";
-  const sel = document.getElementById("view-mode");
+  // benchmarks: n frames rendered back to back, each waited for (a one-pixel read), in ms per frame
+viz.renderSync = (n) => {
+  const gl = renderer.getContext(), px = new Uint8Array(4), t0 = performance.now();
+  for (let i = 0; i < n; i++) { renderer.render(scene, camera); gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, px); }
+  return (performance.now() - t0) / n;
+};
+const sel = document.getElementById("view-mode");
   if (sel && sel.value !== mode) sel.value = mode;
 }
 viz.setViewMode = setMode;
@@ -109,6 +116,7 @@ function placeCamera(w, h) {
 
 // ----------------------------------------------------------------- displays
 const objects = new Map();  // slot -> { key, obj, ... }
+viz.objects3d = objects;  // for tests: what each display drew
 function slotObject(slot, key, make) {
   let o = objects.get(slot);
   if (o && o.key !== key) { scene.remove(o.obj); dispose(o.obj); o = null; }
@@ -167,14 +175,45 @@ function paletteTexture(scheme) {
   tex.magFilter = tex.minFilter = THREE.NearestFilter; tex.needsUpdate = true;
   return tex;
 }
+// Far from the camera many cells fall on one pixel. The cells carry a chain of coarser levels
+// (mipmaps) built by "the most occupied wins" (signed max: unknown -1 < free 0 < occupied
+// 1..100), so a zoomed-out map keeps its walls instead of shimmering between cells, and the
+// renderer reads a few neighbouring texels per pixel instead of scattering over the whole
+// texture (with software WebGL the map plane was most of a frame's cost)
+function mapLevels(m) {
+  const levels = [{ data: new Uint8Array(m.cells.buffer, m.cells.byteOffset, m.w * m.h), width: m.w, height: m.h }];
+  for (let w = m.w, h = m.h; w > 1 || h > 1;) {
+    w = Math.max(1, w >> 1); h = Math.max(1, h >> 1);
+    levels.push({ data: new Uint8Array(w * h), width: w, height: h });
+  }
+  reduceLevels(levels, 0, 0, m.w, m.h);
+  return levels;
+}
+function reduceLevels(levels, x0, y0, x1, y1) {  // recompute the coarse levels over a window of level 0
+  for (let k = 1; k < levels.length; k++) {
+    const a = levels[k - 1], b = levels[k];
+    const src = new Int8Array(a.data.buffer, a.data.byteOffset, a.width * a.height);
+    const dst = new Int8Array(b.data.buffer, b.data.byteOffset, b.width * b.height);
+    x0 >>= 1; y0 >>= 1; x1 = Math.min(b.width, (x1 + 1) >> 1); y1 = Math.min(b.height, (y1 + 1) >> 1);
+    for (let y = y0; y < y1; y++) {
+      const r0 = Math.min(2 * y, a.height - 1) * a.width, r1 = Math.min(2 * y + 1, a.height - 1) * a.width;
+      for (let x = x0; x < x1; x++) {
+        const c0 = Math.min(2 * x, a.width - 1), c1 = Math.min(2 * x + 1, a.width - 1);
+        dst[y * b.width + x] = Math.max(src[r0 + c0], src[r0 + c1], src[r1 + c0], src[r1 + c1]);
+      }
+    }
+  }
+}
 function updateMap(slot, d, L, info) {
   const m = L.map;
   if (!m) return;
   const e = slotObject(slot, `map ${m.w} ${m.h} ${m.res} ${m.ox} ${m.oy} ${m.oyaw}`, () => {
-    const bytes = new Uint8Array(m.cells.buffer, m.cells.byteOffset, m.w * m.h);
-    const cells = new THREE.DataTexture(bytes, m.w, m.h, THREE.RedFormat, THREE.UnsignedByteType);
-    cells.magFilter = cells.minFilter = THREE.NearestFilter; cells.generateMipmaps = false;
-    cells.unpackAlignment = 1; cells.needsUpdate = true;
+    const levels = mapLevels(m);
+    m.dirty3 = null;
+    const cells = new THREE.DataTexture(levels[0].data, m.w, m.h, THREE.RedFormat, THREE.UnsignedByteType);
+    cells.mipmaps = levels;
+    cells.magFilter = THREE.NearestFilter; cells.minFilter = THREE.NearestMipmapNearestFilter;
+    cells.generateMipmaps = false; cells.unpackAlignment = 1; cells.needsUpdate = true;
     const mat = new THREE.ShaderMaterial({
       uniforms: { cells: { value: cells }, palette: { value: paletteTexture(d.options.color_scheme) }, alpha: { value: 1 } },
       vertexShader: MAP_VERTEX, fragmentShader: MAP_FRAGMENT, transparent: true, depthWrite: false, side: THREE.DoubleSide,
@@ -188,7 +227,10 @@ function updateMap(slot, d, L, info) {
     return g;
   });
   const u = e.obj.userData;
-  if (u.version !== m.version) { u.cells.needsUpdate = true; u.version = m.version; }
+  if (u.version !== m.version) {
+    if (m.dirty3) { reduceLevels(u.cells.mipmaps, ...m.dirty3); m.dirty3 = null; }
+    u.cells.needsUpdate = true; u.version = m.version;
+  }
   if (u.scheme !== d.options.color_scheme) {
     u.mat.uniforms.palette.value.dispose();
     u.mat.uniforms.palette.value = paletteTexture(d.options.color_scheme);
@@ -348,7 +390,11 @@ function updatePoses(slot, d, L) {
     for (let i = 0; i < p.length; i += 3) g.add(arrowMesh(o.length, col(o.color), o.alpha));
     return g;
   });
-  e.obj.children.forEach((a, j) => { a.position.set(p[3 * j], p[3 * j + 1], 0.02); a.rotation.set(0, 0, p[3 * j + 2]); });
+  const q = L.poses3;  // full poses: the arrow at its height, fully oriented
+  e.obj.children.forEach((a, j) => {
+    if (q) { a.position.set(q[7 * j], q[7 * j + 1], q[7 * j + 2]); a.quaternion.set(q[7 * j + 3], q[7 * j + 4], q[7 * j + 5], q[7 * j + 6]); }
+    else { a.position.set(p[3 * j], p[3 * j + 1], 0.02); a.rotation.set(0, 0, p[3 * j + 2]); }
+  });
 }
 function updatePath(slot, d, L) {
   const p = L.path;
@@ -357,8 +403,10 @@ function updatePath(slot, d, L) {
     new THREE.LineBasicMaterial({ color: col(d.options.color), transparent: true, opacity: d.options.alpha })));
   if (e.path === p) return;
   e.path = p;
-  const pts = new Float32Array(p.length / 2 * 3);
-  for (let i = 0, k = 0; i < p.length; i += 2, k += 3) { pts[k] = p[i]; pts[k + 1] = p[i + 1]; pts[k + 2] = 0.03; }
+  const q = L.path3, pts = new Float32Array(p.length / 2 * 3);
+  for (let i = 0, k = 0; i < p.length; i += 2, k += 3) {
+    pts[k] = p[i]; pts[k + 1] = p[i + 1]; pts[k + 2] = q ? q[k + 2] : 0.03;
+  }
   e.obj.geometry.setAttribute("position", new THREE.BufferAttribute(pts, 3));
   e.obj.geometry.computeBoundingSphere();
 }
@@ -367,6 +415,25 @@ function updateMarkers(slot, L) {
   const e = slotObject(slot, "markers", () => new THREE.Group());
   if (e.items === L.markers) return;
   e.items = L.markers;
+  if (L.markers3d) {  // Marker / MarkerArray: each (ns, id) in full 3D, rebuilt only when it changed
+    const old = e.byId || new Map(), next = new Map();
+    for (const m of L.markers3d) {
+      const id = m.ns + "/" + m.id, shape = markerShapeKey(m);
+      let it = old.get(id);
+      if (it && it.shape !== shape) { e.obj.remove(it.obj); dispose(it.obj); it = null; }
+      if (!it) {
+        const obj = buildMarker(m);
+        if (!obj) continue;
+        it = { shape, obj }; e.obj.add(obj);
+      }
+      old.delete(id);
+      setPose(it.obj, m.pose);
+      next.set(id, it);
+    }
+    for (const it of old.values()) { e.obj.remove(it.obj); dispose(it.obj); }  // deleted / expired
+    e.byId = next;
+    return;
+  }
   for (const c of [...e.obj.children]) { e.obj.remove(c); dispose(c); }
   for (const m of L.markers) {
     const c = new THREE.Color(m.rgba[0], m.rgba[1], m.rgba[2]), a = m.rgba[3];
@@ -384,15 +451,12 @@ function updateMarkers(slot, L) {
       e.obj.add(new THREE.Points(new THREE.BufferGeometry().setFromPoints(v3), new THREE.PointsMaterial({ color: c, size: Math.max(m.size, 0.02) })));
     } else if (m.shape === "arrow") {
       const ar = arrowMesh(m.length, c, a); ar.position.copy(v3[0]); ar.rotation.z = m.yaw; e.obj.add(ar);
-    } else if (m.shape === "text") {
-      tfText.push([m.text, v3[0]]);
     }
   }
 }
 
 // TF names as HTML labels, pushed apart so none overlap (rviz draws them over each other)
 let tfLabels = [];
-let tfText = [];
 const labelPool = [];
 function placeLabels(camera, w, h) {
   const items = [];
@@ -418,8 +482,10 @@ function placeLabels(camera, w, h) {
     el.style.cssText = "position:absolute;font:11px sans-serif;color:#fff;background:rgba(0,0,0,0.45);padding:0 3px;white-space:nowrap";
     labels.appendChild(el); labelPool.push(el);
   }
-  labelPool.forEach((el, i) => {
-    const q = placed[i];
+  labelPool.forEach((el, i) => {  // the DOM is touched only where a label changed (style writes cost paint)
+    const q = placed[i], want = q ? `${q.name} ${q.x.toFixed(0)} ${q.y.toFixed(0)}` : "";
+    if (el.dataset.was === want) return;
+    el.dataset.was = want;
     if (!q) { el.style.display = "none"; return; }
     el.style.display = "block"; el.textContent = q.name;
     el.style.transform = `translate(${q.x.toFixed(0)}px, ${q.y.toFixed(0)}px)`;
@@ -429,7 +495,7 @@ function placeLabels(camera, w, h) {
 
 function updateScene() {
   for (const o of objects.values()) o.seen = false;
-  tfLabels = []; tfText = [];
+  tfLabels = [];
   const cfg = data.config;
   if (cfg) {
     cfg.displays.forEach((d, slot) => {
@@ -544,6 +610,7 @@ function frame() {
     toolArrow.visible = true; toolArrow.position.set(drag.p.x, drag.p.y, 0.05); toolArrow.rotation.set(0, 0, drag.yaw);
     toolArrow.children.forEach((m) => m.material.color.setHex(c));
   } else toolArrow.visible = false;
+  setLineResolution(w, h);
   renderer.render(scene, camera);
   const t2 = performance.now();
   placeLabels(camera, w, h);
@@ -562,6 +629,12 @@ function frame() {
     if (cam.resolution !== r) renderer.setPixelRatio(cam.resolution * (window.devicePixelRatio || 1));
   }
 }
+// benchmarks: n frames rendered back to back, each waited for (a one-pixel read), in ms per frame
+viz.renderSync = (n) => {
+  const gl = renderer.getContext(), px = new Uint8Array(4), t0 = performance.now();
+  for (let i = 0; i < n; i++) { renderer.render(scene, camera); gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, px); }
+  return (performance.now() - t0) / n;
+};
 const sel = document.getElementById("view-mode");
 if (sel) sel.onchange = () => setMode(sel.value);
 requestAnimationFrame(frame);
