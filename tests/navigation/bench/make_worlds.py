@@ -4,7 +4,8 @@
 * ``cluttered.yaml``: a 10 x 10 m walled field with 40 boxes and cylinders (0.2..0.8 m)
   at seeded random places, at least 0.5 m apart and 0.8 m from the spawn;
 * ``narrow_doors.yaml``: four 3 x 3 m rooms in a row and a hall, joined by doors 0.45 m
-  wide (about twice mybot's 0.22 m width);
+  between the wall segments' ends, 0.35 m clear (a wall reaches half its 0.1 m thickness
+  past its ends): 1.75 times mybot's 0.20 m width;
 * ``corridor.yaml``: a 24 m x 1.2 m corridor and a parallel 1.0 m one, joined at both
   ends (a 50 m loop), with two alcoves and five thin pillars by the walls.
 """

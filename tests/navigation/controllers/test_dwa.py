@@ -11,6 +11,7 @@ from roverlab.geometry import SE2
 from roverlab.navigation.controllers import DWAParams, DWAPlanner, Velocity2D
 from roverlab.navigation.controllers.dwa import velocity_iterator
 from roverlab.navigation.costmap import Costmap2D, footprint_from_radius
+from roverlab.navigation.costmap.kernels import footprint_cost
 from roverlab.navigation.errors import InvalidPathError, NavigationParamsError, NoValidControlError
 from tests.navigation.controllers.conftest import DWA
 from tests.navigation.controllers.sim import ROBOT_RADIUS, field_world, run
@@ -59,10 +60,56 @@ def test_pruned_scoring_chooses_what_full_scoring_chooses(dwa_params: DWAParams)
             continue
         best_pruned = int(np.flatnonzero(dwa.costs == dwa.costs[dwa.costs >= 0].min())[0])
         best, full = dwa._score(pose, twist, dwa.samples, cm, dwa._only, prune=False)
+        if best < 0:  # a lethal cell under the robot: the escape chose (tested below)
+            continue
         assert best == best_pruned, trial
         assert full[best] == pytest.approx(dwa.costs[best])
         valid = full >= 0
         assert (dwa.costs[valid] <= full[valid] + 1e-9).all()  # pruned ones are lower bounds
+
+
+def test_escape_from_a_lethal_cell_under_the_footprint(dwa_params: DWAParams) -> None:
+    """Every rollout starts at the robot's pose, so a lethal cell under its outline (one
+    CostmapModel's outline missed on the way in) refuses every sample: DWA drives to the
+    cheapest pose clear of that cell, still refusing every other lethal cell."""
+    fp = np.array([[-0.125, -0.1], [-0.125, 0.1], [0.125, 0.1], [0.125, -0.1]])
+    plan = np.array([[1.5, 1.5, 0.0], [2.5, 1.5, 0.0], [2.9, 1.5, 0.0]])
+    pose = SE2(1.5, 1.5, 0.0)
+    cm = _open()
+    cm.costs[int(1.6 / 0.05), int(1.5 / 0.05)] = 254  # under the left edge
+    buf = np.empty((256, 2), dtype=np.int64)
+    # every rollout's first pose is refused by the footprint check
+    assert footprint_cost(cm.costs, 0.05, 0.0, 0.0, 1.5, 1.5, 0.0, fp, 1.0, buf) < 0
+    dwa = DWAPlanner(dwa_params, footprint=fp)
+    cmd = dwa.compute_velocity(pose, Velocity2D(), plan, cm)
+    assert cmd.vx > 0.0  # on along the plan, away from the cell
+    assert len(dwa.trajectory) > 1
+    # walled in ahead and behind: no sample gets clear without crossing other lethal cells
+    boxed = cm.copy()
+    boxed.costs[:, int(1.75 / 0.05)] = 254
+    boxed.costs[:, int(1.25 / 0.05)] = 254
+    with pytest.raises(NoValidControlError):
+        DWAPlanner(dwa_params, footprint=fp).compute_velocity(pose, Velocity2D(), plan, boxed)
+
+
+def test_nose_goal_stops_short_of_a_wall(dwa_params: DWAParams) -> None:
+    """A goal 0.25 m from a wall (the held-out corridor's goal 7): moved the full
+    forward_point_distance (0.325 m) from the robot, the nose goal lies in the wall's
+    inscribed band, its wavefront cannot leave the band and the goal-front critic sees every
+    free cell as unreachable (DWA spun in place 0.15 m from the goal). It stops before the
+    band, so the grid leads to the goal."""
+    cm = _open()
+    wall_row = int(2.0 / 0.05)
+    cm.costs[wall_row:, :] = 254
+    cm.costs[wall_row - 2 : wall_row, :] = 253  # inscribed band
+    dwa = DWAPlanner(dwa_params, footprint=FOOT)
+    plan = np.array([[1.5, 1.2, math.pi / 2], [1.5, 1.5, math.pi / 2], [1.5, 1.75, math.pi / 2]])
+    dwa.compute_velocity(SE2(1.5, 1.2, math.pi / 2), Velocity2D(), plan, cm)
+    front = dwa._grids[2]
+    size = cm.size_x * cm.size_y
+    here = front[int(1.2 / 0.05), int(1.5 / 0.05)]
+    assert here < size  # reachable from the nose goal
+    assert front[int(1.2 / 0.05), int(1.5 / 0.05)] > front[int(1.7 / 0.05), int(1.5 / 0.05)]
 
 
 def test_rotate_in_place_at_the_goal_then_reached(dwa_params: DWAParams) -> None:

@@ -242,3 +242,25 @@ def test_planner_parameters_from_ros() -> None:
         GlobalPlannerParams.from_ros({"use_dijkstraa": True})
     with pytest.raises(NavigationParamsError, match="default_tolerance must be >= 0"):
         NavfnParams.from_ros({"default_tolerance": -1.0})
+
+
+def test_global_planner_descent_ends_in_the_starts_seeded_block() -> None:
+    """The held-out corridor (DWA, seed 0, goals 12-18): mybot stood by a wall in inflated
+    cost, its start 0.004 cells below a cell boundary, so global_planner's precise start
+    gave both upper cells of its 2 x 2 block potential 0. The descent along the wall (the
+    cells above lethal: grid steps) stopped in the left one, 0.81 cells from the start:
+    no lower neighbour, not within half a cell, and ROS's GlobalPlanner (like roverlab's
+    before) failed "to get a plan from potential when a legal potential was found"."""
+    res = 0.05
+    cm = Costmap2D(size_x=40, size_y=20, resolution=res)
+    cm.costs[12:, :] = 254  # the wall above the start's row
+    cm.costs[:1, :] = 254
+    start = SE2((20.81 + 0.5) * res, (10.996 + 0.5) * res, math.pi)
+    goal = SE2(0.3, (11 + 0.5) * res, math.pi)
+    planner = GlobalPlanner(GlobalPlannerParams(use_dijkstra=True, use_quadratic=True))
+    path = planner.plan(start, goal, cm)
+    pot = planner.potential
+    assert pot is not None and pot[11, 20] == pot[11, 21] == 0.0  # two zero seeds
+    assert np.hypot(*(path[0, :2] - [start.x, start.y])) < res
+    assert np.hypot(*(path[-1, :2] - [goal.x, goal.y])) < 1e-9
+    assert path_length(path) < (start.x - goal.x) * 1.2

@@ -23,6 +23,7 @@ __all__ = [
     "inflate",
     "line_cost",
     "mark_points",
+    "outline_cells",
 ]
 
 _jit = numba.njit(cache=True, nogil=True)
@@ -330,3 +331,37 @@ def footprint_cost(
         px0 = mx
         py0 = my
     return max(best, center)
+
+
+@_jit
+def outline_cells(
+    w: int,
+    h: int,
+    res: float,
+    ox: float,
+    oy: float,
+    x: float,
+    y: float,
+    th: float,
+    fp: NDArray[np.float64],
+    out: NDArray[np.int64],
+) -> int:
+    """Every cell (flat index ``my * w + mx``) that the outline of the polygon ``fp`` at
+    ``(x, y, th)`` crosses, from the vertices' true positions (roverlab's exact grid
+    tracer, clipped to the grid), written to ``out`` (room for ``2 * (w + h)`` per edge);
+    returns the count (cells shared by two edges appear twice)."""
+    c = math.cos(th)
+    s = math.sin(th)
+    m = fp.shape[0]
+    n = 0
+    gx0 = 0.0
+    gy0 = 0.0
+    for k in range(m + 1):
+        j = k % m
+        gx = (x + fp[j, 0] * c - fp[j, 1] * s - ox) / res
+        gy = (y + fp[j, 0] * s + fp[j, 1] * c - oy) / res
+        if k > 0:
+            n += trace_segment_cells(gx0, gy0, gx, gy, w, h, out[n:])
+        gx0 = gx
+        gy0 = gy
+    return n

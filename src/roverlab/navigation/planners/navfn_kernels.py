@@ -258,8 +258,12 @@ def calc_path(
     quarter of a cell of the one two steps back) it steps to the lowest neighbour
     instead. ``navfn_stop``: stop when the nearest cell's potential is
     below ``COST_NEUTRAL`` (navfn); otherwise when within half a cell of the end
-    (global_planner) or in the end's cell (global_planner's test alone misses an end in
-    the upper half of its cell when the descent arrives at the cell's corner). Writes
+    (global_planner) or in one of the four cells of the end's 2 x 2 block, the cells
+    global_planner's precise start seeds. global_planner's test alone misses the end when
+    the descent arrives at a seeded cell more than half a cell from it: the seeds are the
+    potential's minima (with the end on a cell boundary two of them are 0), so the grid
+    descent stays in that cell until it gives up ("failed to get a plan from potential
+    when a legal potential was found", from a robot standing in inflated cost). Writes
     ``(x, y)`` rows into ``out``; returns the count, 0 on failure.
     """
     ns = pot.shape[0]
@@ -270,7 +274,7 @@ def calc_path(
     dy = start_y - int(start_y)
     npath = 0
     cap = out.shape[0]
-    end_cell = int(end_y) * nx + int(end_x)
+    end_cell = int(end_y) * nx + int(end_x)  # the 2 x 2 block: end_cell, +1, +nx, +nx + 1
     for _ in range(max_steps):
         if navfn_stop:
             near = stc + int(round(dx)) + nx * int(round(dy))
@@ -284,7 +288,8 @@ def calc_path(
         else:
             px = stc % nx + dx
             py = stc // nx + dy
-            if (abs(px - end_x) < 0.5 and abs(py - end_y) < 0.5) or stc == end_cell:
+            d = stc - end_cell
+            if (abs(px - end_x) < 0.5 and abs(py - end_y) < 0.5) or (d in (0, 1, nx, nx + 1)):
                 if npath < cap:
                     out[npath, 0] = end_x
                     out[npath, 1] = end_y

@@ -37,7 +37,13 @@ from roverlab.navigation.controllers.base import (
 )
 from roverlab.navigation.controllers.dwa.kernels import rollout, score_rollouts, target_distance
 from roverlab.navigation.controllers.dwa.params import DWAParams
-from roverlab.navigation.costmap.costmap_2d import NO_INFORMATION, Costmap2D
+from roverlab.navigation.costmap.costmap_2d import (
+    INSCRIBED_INFLATED_OBSTACLE,
+    LETHAL_OBSTACLE,
+    NO_INFORMATION,
+    Costmap2D,
+)
+from roverlab.navigation.costmap.kernels import footprint_cost, outline_cells
 from roverlab.navigation.errors import InvalidPathError, NoValidControlError
 
 __all__ = ["DWAPlanner", "velocity_iterator"]
@@ -76,6 +82,25 @@ def _adjust_resolution(plan: NDArray[np.float64], resolution: float) -> NDArray[
             out.append(a + j * (b - a) / steps)
         out.append(b[None, :])
     return np.concatenate(out)
+
+
+def _free_shift(cm: Costmap2D, gx: float, gy: float, ang: float, distance: float) -> float:
+    """How far the nose goal moves from the local goal ``(gx, gy)`` along ``ang``: up to
+    ``distance`` (``forward_point_distance``), in half-cell steps, stopping before a lethal,
+    inscribed or unknown cell (a roverlab change: ROS moves it the full distance, into a
+    wall when the goal is within that distance of one; the goal-front grid's wavefront
+    then cannot leave the wall, every free cell is unreachable, and DWA spun in place
+    0.15 m from such a goal until move_base aborted)."""
+    step = cm.resolution / 2.0
+    c, s = math.cos(ang), math.sin(ang)
+    d = 0.0
+    while d < distance - 1e-9:
+        nxt = min(d + step, distance)
+        cell = cm.world_to_map(gx + nxt * c, gy + nxt * s)
+        if cell is None or cm.costs[cell[1], cell[0]] >= INSCRIBED_INFLATED_OBSTACLE:
+            break
+        d = nxt
+    return d
 
 
 class DWAPlanner:
@@ -198,9 +223,10 @@ class DWAPlanner:
         target_distance(cm.costs, np.ascontiguousarray(cells[end - 1 : end]), goal_grid)
         g = plan[-1]
         ang = math.atan2(g[1] - pose.y, g[0] - pose.x)
+        shift = _free_shift(cm, float(g[0]), float(g[1]), ang, p.forward_point_distance)
         front = plan.copy()
-        front[-1, 0] += p.forward_point_distance * math.cos(ang)
-        front[-1, 1] += p.forward_point_distance * math.sin(ang)
+        front[-1, 0] += shift * math.cos(ang)
+        front[-1, 1] += shift * math.sin(ang)
         fadj = _adjust_resolution(front, res)
         fcells = np.floor((fadj - [cm.origin_x, cm.origin_y]) / res).astype(np.int64)
         fin = (
@@ -364,6 +390,8 @@ class DWAPlanner:
             return self._stop_rotate(pose, twist, costmap)
         samples = self._sample_velocities(pose, twist)
         best, costs = self._score(pose, twist, samples, costmap, self._only)
+        if best < 0:
+            best, costs = self._escape(pose, twist, samples, costmap, costs)
         self.samples, self.costs = samples, costs
         if best < 0:
             raise NoValidControlError(
@@ -381,6 +409,57 @@ class DWAPlanner:
         )  # fmt: skip
         self.trajectory = traj[:n].copy()
         return Velocity2D(float(cmd[0]), float(cmd[1]), float(cmd[2]))
+
+    def _escape(
+        self, pose: SE2, vel: Velocity2D, samples: NDArray[np.float64], cm: Costmap2D,
+        costs: NDArray[np.float64],
+    ) -> tuple[int, NDArray[np.float64]]:  # fmt: skip
+        """roverlab's way out when every sample was refused because the robot already
+        stands over lethal cells: the footprint check (CostmapModel's Bresenham outline)
+        can miss a lethal cell a slanted edge crosses, so the robot drives over it, and from
+        there every motion's check catches it (and rotate_recovery refuses to turn). The
+        lethal cells the footprint's exact outline crosses at the current pose are then
+        scored as inscribed, and the cheapest sample whose last pose is clear of them (and
+        legal on the costmap as it is) is taken. Any other lethal cell still refuses a
+        sample. Returns ``(-1, costs)`` when the robot is not over a lethal cell or no
+        sample gets clear."""
+        fp = self.footprint
+        if len(fp) < 3:
+            return -1, costs
+        p = self.params
+        w, h = cm.size_x, cm.size_y
+        buf = np.empty((len(fp) + 1) * 2 * (w + h + 2), dtype=np.int64)
+        args = (w, h, cm.resolution, cm.origin_x, cm.origin_y)
+        n = outline_cells(*args, pose.x, pose.y, pose.theta, fp, buf)
+        cells = np.unique(buf[:n])
+        stuck = cells[cm.costs.reshape(-1)[cells] == LETHAL_OBSTACLE]
+        if len(stuck) == 0:
+            return -1, costs
+        relaxed = cm.copy()
+        relaxed.costs.reshape(-1)[stuck] = INSCRIBED_INFLATED_OBSTACLE
+        best, rcosts = self._score(pose, vel, samples, relaxed, self._only, prune=False)
+        if best < 0:
+            return -1, costs
+        acc = np.array([p.acc_lim_x, p.acc_lim_y, p.acc_lim_theta])
+        traj = np.empty((int(p.sim_time / min(p.sim_granularity, 1.0)) * 4 + 64, 3))
+        line = np.empty((w + h + 4, 2), dtype=np.int64)
+        for k in np.argsort(np.where(rcosts >= 0, rcosts, np.inf), kind="stable"):
+            if rcosts[k] < 0:
+                break
+            num, _, _ = rollout(
+                pose.as_array(), vel.as_array(), samples[k], p.sim_time, p.sim_granularity,
+                p.angular_sim_granularity, not p.use_dwa, acc, 0.0, traj,
+            )  # fmt: skip
+            if num == 0:
+                continue
+            x, y, th = (float(v) for v in traj[num - 1])
+            m = outline_cells(*args, x, y, th, fp, buf)
+            if np.isin(buf[:m], stuck).any():
+                continue
+            if footprint_cost(cm.costs, *args[2:], x, y, th, fp, 1.0, line) < 0:
+                continue
+            return int(k), rcosts
+        return -1, costs
 
     def _stop_rotate(self, pose: SE2, twist: Velocity2D, cm: Costmap2D) -> Velocity2D:
         """LatchedStopRotateController::computeVelocityCommandsStopRotate."""
