@@ -27,9 +27,10 @@ def child(method: str, log: str) -> None:
     """One method on one log with default parameters, exactly as ``roverlab slam run``."""
     from roverlab.cli import slam_run
     from roverlab.slam.data.logs import load_log
+    from roverlab.slam.data.reversing import ReversingRepair
 
     t0 = time.perf_counter()
-    records = load_log(log)
+    records = load_log(log, reversing=ReversingRepair())  # as slam run reads CARMEN logs
     t_load = time.perf_counter() - t0
     runner = getattr(slam_run, f"run_{method}", None)
     if runner is None:

@@ -14,7 +14,7 @@ from roverlab.cli.launch import choose_clock
 from roverlab.launch import LaunchError, load_launch
 from tests.helpers.procs import Proc
 
-FIXTURES = Path(__file__).resolve().parents[1] / "mapping" / "fixtures"
+FIXTURES = Path(__file__).resolve().parents[1] / "slam" / "fixtures"
 
 
 def _launch(tmp_path: Path, body: str) -> Path:

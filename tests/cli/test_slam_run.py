@@ -10,6 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from tests.cli.test_amcl_run import _reversing_log
+
 DATA = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "radish"
 
 
@@ -209,3 +211,26 @@ def test_a_simulator_recording_maps_the_maze(tmp_path: Path, method: str) -> Non
         capture_output=True, text=True, timeout=120,
     )  # fmt: skip
     assert e.returncode == 0, e.stdout + e.stderr
+
+
+def test_slam_run_repairs_odometry_logged_forward_while_reversing(tmp_path: Path) -> None:
+    """As ``amcl run``: a CARMEN log's steps that went forward while ``tv`` < 0 are reversed
+    (the graph without scan matching follows the odometry, so its trajectory shows it)."""
+    log = _reversing_log(tmp_path / "rev.clf")
+
+    def run(out: str, *extra: str) -> tuple[str, np.ndarray]:
+        r = subprocess.run(
+            [sys.executable, "-m", "roverlab.cli", "slam", "run", str(log), "--method", "graph",
+             "--param", "use_scan_matching:=false", "--out", str(tmp_path / out), *extra],
+            capture_output=True, text=True, timeout=300,
+        )  # fmt: skip
+        assert r.returncode == 0, r.stderr
+        return r.stderr, np.loadtxt(tmp_path / out / "trajectory.tum")
+
+    err, fixed = run("a")
+    assert "odometry: 10 of 29 steps moved forward while the velocity was negative" in err
+    raw_err, logged = run("b", "--logged-odometry")
+    assert "odometry:" not in raw_err
+    # 30 steps of 3 cm: as logged all forward (0.87 m), repaired 19 forward and 10 back
+    assert logged[-1, 1] - logged[0, 1] == pytest.approx(0.87, abs=1e-6)
+    assert fixed[-1, 1] - fixed[0, 1] == pytest.approx(0.27, abs=1e-6)

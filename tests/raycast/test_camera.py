@@ -18,8 +18,9 @@ from roverlab.raycast import (
     depth_to_points,
     optical_to_body,
     render,
+    render_rgb,
 )
-from tests.raycast.helpers import box_segments
+from tests.raycast.helpers import box_segments, random_scene
 
 W, H, HFOV = 161, 121, 1.2  # odd sizes: pixel (60, 80) is exactly on the optical axis
 INTR = camera_intrinsics(W, H, HFOV)
@@ -306,3 +307,21 @@ def test_render_validation() -> None:
         render(scene, 0.0, 0.0, 1.0, 0.0, **CAM, pitch=1.4)
     with pytest.raises(RaycastInputError):
         depth_to_points(np.zeros((2, 3, 4)), HFOV)
+
+
+@pytest.mark.parametrize("pitch", [0.0, 0.15])
+def test_render_rgb_is_renders_image_and_writes_every_pixel_of_out(pitch: float) -> None:
+    rng = np.random.default_rng(5)
+    scene = random_scene(rng)
+    out = np.full((48, 64, 3), 123, dtype=np.uint8)
+    for _ in range(6):
+        x, y = rng.uniform(-4, 4, 2)
+        yaw = float(rng.uniform(-3, 3))
+        kw = {"hfov": 1.2, "width": 64, "height": 48, "near": 0.05, "far": 30.0, "pitch": pitch}
+        rgb, _ = render(scene, x, y, 0.3, yaw, **kw)
+        got = render_rgb(scene, x, y, 0.3, yaw, out=out, **kw)
+        assert got is out
+        np.testing.assert_array_equal(got, rgb)
+    with pytest.raises(RaycastInputError, match="out must be"):
+        render_rgb(scene, 0, 0, 0.3, 0, hfov=1.2, width=64, height=48, near=0.05, far=30.0,
+                   out=np.zeros((48, 64, 4), dtype=np.uint8))  # fmt: skip

@@ -68,6 +68,42 @@ def test_cast_2d_many_equals_cast_2d_per_pose() -> None:
     assert np.isfinite(many).sum() > 500
 
 
+@pytest.mark.parametrize("seed", range(4))
+def test_uniform_fans_take_the_angular_sweep_with_the_grid_walks_ranges(seed: int) -> None:
+    """A uniform fan in a small scene is cast by the angular sweep (raycast.sweep); the
+    same beams in shuffled order walk the grid; both equal brute force, and each other to
+    the bit, also from poses on segment ends and lines and inside circles."""
+    rng = np.random.default_rng(100 + seed)
+    scene = random_scene(rng, n_seg=30, n_circ=8)
+    n = 360
+    rel = rng.uniform(-1, 1) + (2 * math.pi / n) * np.arange(n)
+    perm = rng.permutation(n)
+    segs = scene.segments
+    n_hits = 0
+    for i in range(40):
+        if i < 10:  # on a segment end, or along a segment
+            sx0, sy0, sx1, sy1 = segs[rng.integers(len(segs))]
+            f = (0.0, 1.0, 0.5, float(rng.uniform()))[i % 4]
+            x, y = sx0 + f * (sx1 - sx0), sy0 + f * (sy1 - sy0)
+        elif i < 14:  # inside a circle
+            cx, cy, r = scene.circles[rng.integers(len(scene.circles))]
+            x, y = cx + 0.5 * r, cy
+        else:
+            x, y = rng.uniform(-8, 8, 2)
+        yaw = float(rng.uniform(-4, 4))
+        z = float(rng.uniform(0, 1.5))
+        rmax = float(rng.choice([3.0, 12.0]))
+        sweep = cast_2d(scene, x, y, z, rel + yaw, rmax)
+        grid = np.empty(n)
+        grid[perm] = cast_2d(scene, x, y, z, (rel + yaw)[perm], rmax)
+        np.testing.assert_array_equal(sweep, grid)
+        np.testing.assert_allclose(sweep, brute_cast(scene, x, y, z, rel + yaw, rmax), atol=1e-9)
+        many = cast_2d_many(scene, np.array([[x, y, yaw]]), z, rel, rmax)[0]
+        np.testing.assert_allclose(many, sweep, atol=1e-9)
+        n_hits += int(np.isfinite(sweep).sum())
+    assert n_hits > 2000
+
+
 # ---- known geometry -------------------------------------------------------------------
 
 

@@ -1,4 +1,5 @@
-"""Sensor models on their own: the IMU's noise, bias, gravity and centripetal terms."""
+"""Sensor models on their own: the IMU's noise, bias, gravity and centripetal terms; the
+lidar's noise blocks; the camera's reuse of images nobody holds."""
 
 from __future__ import annotations
 
@@ -8,7 +9,16 @@ from typing import Any
 import numpy as np
 import pytest
 
-from roverlab.sim.sensors import GRAVITY, ImuModel, ImuNoise
+from roverlab.raycast import Scene, cast_2d
+from roverlab.sim.sensors import (
+    GRAVITY,
+    CameraModel,
+    CameraParams,
+    ImuModel,
+    ImuNoise,
+    LidarModel,
+    LidarParams,
+)
 
 RATE = ImuNoise(mean=0.0, stddev=0.01, bias_mean=0.05, bias_stddev=0.0)
 ACCEL = ImuNoise(mean=0.02, stddev=0.2, bias_mean=0.3, bias_stddev=0.0)
@@ -55,3 +65,39 @@ def test_noiseless_imu_is_exact_and_seeded_imu_reproduces() -> None:
     assert np.array_equal(a[1], b[1]) and np.array_equal(a[2], b[2])
     assert not np.array_equal(a[1], c[1])
     assert len(np.unique(a[1][:, 0])) == 3000  # no block of noise repeats
+
+
+def test_lidar_noise_drawn_in_blocks_is_the_per_scan_draw() -> None:
+    """Scans take their noise from blocks of rows drawn ahead: the same numbers, in the
+    same order, as one ``rng.normal`` per scan."""
+    scene = Scene(segments=[[-2, -2, 2, -2], [2, -2, 2, 2], [2, 2, -2, 2], [-2, 2, -2, -2]])
+    params = LidarParams(360, 0.0, 2 * math.pi, 0.1, 8.0, 0.0, 0.02, 0.05)
+    model = LidarModel(params, np.random.default_rng(9))
+    rng = np.random.default_rng(9)
+    for k in range(150):  # across blocks
+        yaw = 0.01 * k
+        got = model.scan(scene, 0.3, -0.2, 0.2, yaw)
+        exact = cast_2d(scene, 0.3, -0.2, 0.2, params.angles() + yaw, params.range_max)
+        want = np.where(np.isfinite(exact), exact + rng.normal(0.02, 0.05, 360), np.inf)
+        want = np.where(want > params.range_max, np.inf, want)
+        want = np.where(want < params.range_min, -np.inf, want)
+        np.testing.assert_array_equal(got, want.astype(np.float32))
+
+
+def test_camera_reuses_only_images_nobody_holds() -> None:
+    scene = Scene(segments=[[1, -1, 1, 1]])
+    model = CameraModel(CameraParams(32, 24, 1.0), np.random.default_rng(0))
+    first = model.capture_rgb(scene, 0, 0, 0.2, 0.0)
+    second = model.capture_rgb(scene, 0, 0, 0.2, 0.5)
+    assert second is not first  # first is still held here
+    view = second.reshape(-1)  # as an Image message's data holds it
+    del second
+    third = model.capture_rgb(scene, 0, 0, 0.2, 1.0)
+    assert third is not first and view.base is not third
+    kept = third.copy()
+    del third
+    fourth = model.capture_rgb(scene, 0, 0, 0.2, 1.0)  # the third's buffer, free again
+    np.testing.assert_array_equal(fourth, kept)
+    rgb, _ = model.capture(scene, 0, 0, 0.2, 1.0)
+    np.testing.assert_array_equal(fourth, rgb)
+    np.testing.assert_array_equal(first, model.capture(scene, 0, 0, 0.2, 0.0)[0])

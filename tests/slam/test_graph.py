@@ -24,11 +24,11 @@ from roverlab.slam.data import (
     chi2,
     evaluate,
     iter_log,
-    load_log,
     read_g2o,
     read_relations,
     write_g2o,
 )
+from roverlab.slam.data.mapquality import MapQuality, evaluate_map, grid_from_msg, ground_truth
 from roverlab.slam.graph import (
     NODE_PARAMETERS,
     GraphParams,
@@ -344,6 +344,26 @@ def test_graph_round_trips_through_g2o(
     assert chi2(back) == pytest.approx(chi2(graph), rel=1e-9)
 
 
+def test_a_turn_the_odometry_reports_late_is_found_beyond_the_search_window() -> None:
+    """Turning 10 degrees per scan while the odometry stalls for four scans, then reports
+    the whole 50 degrees at once (mit-csail's odometry does this): the prediction of the
+    fifth scan is ~40 degrees past the truth, twice the +-20 degree window. The match lands
+    on the window's rim and is searched again from there."""
+    scene = _corridor_scene()
+    turn = math.radians(10.0)
+    truth = np.array([[5.0, 1.5, 0.0]] * 3 + [[5.0, 1.5, k * turn] for k in range(1, 10)])
+    odom = truth.copy()
+    odom[3:7, 2] = 0.0  # stalled: scans 3-6 report no turn, scan 7 catches up
+    slam = GraphSLAM(GraphParams())
+    for i, (t, o) in enumerate(zip(truth, odom, strict=True)):
+        r = cast_2d(scene, t[0], t[1], 0.5, t[2] + _ANGLES, _RANGE_MAX)
+        pose = slam.process(r, _ANGLES, o, 0.2 * i, range_max=_RANGE_MAX)
+    heading_error = abs(math.remainder(pose.theta - truth[-1, 2], 2 * math.pi))
+    assert slam.rim_searches >= 1
+    assert math.degrees(heading_error) < 1.0
+    assert math.hypot(pose.x - truth[-1, 0], pose.y - truth[-1, 1]) < 0.05
+
+
 def test_odometry_only_mapping_follows_odometry(
     corridor: tuple[list[ScanRecord], NDArray[np.float64]],
 ) -> None:
@@ -378,27 +398,15 @@ def test_intel_first_1200_scans() -> None:
     assert data_s / cpu > 15.0, (cpu, data_s)
 
 
-def _want_slow(request: pytest.FixtureRequest) -> None:
-    if "slow" not in str(request.config.getoption("markexpr", "")):
-        pytest.skip("full-log benchmark: run with -m slow")
-
-
-@pytest.mark.slow
-@pytest.mark.parametrize(("name", "limit"), [("intel", 0.030), ("fr079", 0.050)])
-def test_full_log_accuracy(request: pytest.FixtureRequest, name: str, limit: float) -> None:
-    _want_slow(request)
-    log = load_log(_data(f"{name}.clf.bz2"))
-    relations = read_relations(_data(f"{name}.relations"))
-    start = time.perf_counter()
-    run = run_graph(log, {})
-    elapsed = time.perf_counter() - start
-    metrics = evaluate(run.trajectory, relations)
-    print(f"\n{name}: {log.duration_s / elapsed:.0f}x real time\n{metrics}")
-    assert metrics.matched == len(relations)
-    assert metrics.trans_mean <= limit, str(metrics)
-
-
 # ------------------------------------------------------------------ the node
+
+
+def _room_map_quality(msg: Any, sim: Simulation) -> MapQuality:
+    """The map scored against the room's ground truth at the lidar's height (the map
+    frame is the world frame: the odometry is the world pose here)."""
+    z = float(sim.config.lidars[0].mount.translation[2])
+    gt = ground_truth(sim.world_model, resolution=float(msg.info.resolution), z_m=max(z, 0.01))
+    return evaluate_map(grid_from_msg(msg), gt)
 
 
 def test_slam_toolbox_node_in_the_simulator() -> None:
@@ -431,8 +439,10 @@ def test_slam_toolbox_node_in_the_simulator() -> None:
     ctx.spin_for(1.1)
     assert node.scans_processed >= 50 and node.slam.num_keyframes >= 5
     assert len(got) >= 2
-    cells = np.asarray(node.map_msg.data)
-    assert (cells == 100).sum() > 100 and (cells == 0).sum() > 1000
+    q = _room_map_quality(node.map_msg, sim)
+    # walls on average within a cell of the world's (the map after 16 s: p95 2 cells)
+    assert q.accuracy >= 0.95 and q.wall_distance_mean <= 1.0, q.summary()
+    assert q.occupied_cells > 100 and q.coverage > 0.5, q.summary()
     tf, _ = buf.lookup_transform("map", "base_footprint", Time(0))
     est = tf.to_se2()
     assert math.hypot(est.x - sim.simulator.x, est.y - sim.simulator.y) < 0.05

@@ -15,7 +15,7 @@ from PIL import Image
 
 from roverlab.geometry import SE2
 from roverlab.raycast import Scene, cast_2d
-from roverlab.slam.data import ScanRecord, evaluate, iter_log, load_log, read_relations
+from roverlab.slam.data import ScanRecord, evaluate, iter_log, read_relations
 from roverlab.slam.hector import (
     NODE_PARAMETERS,
     HectorInputError,
@@ -645,28 +645,3 @@ def test_intel_default_map_is_too_small_and_says_so() -> None:
     slam = HectorSLAM()  # 1024 x 2.5 cm: 25.6 m across
     with pytest.raises(OutOfMapError, match="map_size"):
         slam.run_log(log)
-
-
-def _want_slow(request: pytest.FixtureRequest) -> None:
-    if "slow" not in str(request.config.getoption("markexpr", "")):
-        pytest.skip("full-log benchmark: run with -m slow")
-
-
-@pytest.mark.slow
-def test_intel_full_log(request: pytest.FixtureRequest, tmp_path: Path) -> None:
-    _want_slow(request)
-    log = load_log(_data("intel.clf.bz2"))
-    relations = read_relations(_data("intel.relations"))
-    slam = HectorSLAM(HectorParams(map_size=2048))
-    start = time.perf_counter()
-    run = slam.run_log(log)
-    elapsed = time.perf_counter() - start
-    metrics = evaluate(run.trajectory, relations)
-    print(
-        f"\nintel: {len(log)} scans in {elapsed:.1f} s = {len(log) / elapsed:.0f} scans/s, "
-        f"{log.duration_s / elapsed:.0f}x real time\n{metrics}"
-    )
-    assert metrics.matched == len(relations)
-    assert metrics.trans_mean <= 0.20
-    assert log.duration_s / elapsed >= 20.0
-    _save_png(tmp_path / "intel.png", run.map, [(run.poses, (255, 0, 0))])

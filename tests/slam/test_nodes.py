@@ -20,6 +20,7 @@ from roverlab.msgs import classes as mc
 from roverlab.raycast import Scene, cast_2d
 from roverlab.sim.app import Simulation
 from roverlab.sim.node import SpawnPose
+from roverlab.slam.data.mapquality import MapQuality, evaluate_map, grid_from_msg, ground_truth
 from roverlab.slam.gmapping import GMappingParams
 from roverlab.slam.gmapping.node import SlamGMapping
 from roverlab.slam.graph.node import SlamToolbox
@@ -47,6 +48,14 @@ FAST_GMAPPING = {"particles": 8, "map_update_interval": 1.0, "base_frame": "base
 
 def _room() -> Any:
     return world_from_dict(ROOM, source=Path("room.yaml"))
+
+
+def _room_map_quality(msg: Any, sim: Simulation) -> MapQuality:
+    """The map scored against the room's ground truth at the lidar's height (the map
+    frame is the world frame: the odometry is the world pose here)."""
+    z = float(sim.config.lidars[0].mount.translation[2])
+    gt = ground_truth(sim.world_model, resolution=float(msg.info.resolution), z_m=max(z, 0.01))
+    return evaluate_map(grid_from_msg(msg), gt)
 
 
 def _collect(ctx: Context, topics: dict[str, Any]) -> dict[str, list[Any]]:
@@ -93,8 +102,9 @@ def test_gmapping_node_in_the_simulator() -> None:
     ctx.spin_for(0.01)
     assert len(late) == 1 and late[0].header.frame_id == "map"
     assert late[0].info.resolution == pytest.approx(0.05)
-    cells = np.asarray(late[0].data)
-    assert (cells == 100).sum() > 100 and (cells == 0).sum() > 1000
+    q = _room_map_quality(late[0], sim)
+    assert q.accuracy >= 0.95 and q.wall_distance_p95 <= 1.0, q.summary()
+    assert q.occupied_cells > 100 and q.coverage > 0.5, q.summary()
     # entropy of 8 weights: in [0, log 8]
     ent = [m.data for m in got["/slam_gmapping/entropy"]]
     assert len(ent) == len(stamps) and all(0.0 <= e <= math.log(8) + 1e-9 for e in ent)

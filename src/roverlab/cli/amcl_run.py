@@ -15,6 +15,7 @@ from roverlab.cli.log_input import (
     BaseFrameOption,
     FirstOption,
     LogArgument,
+    LoggedOdometryOption,
     OdomFrameOption,
     OdomTopicOption,
     ParamOption,
@@ -23,6 +24,7 @@ from roverlab.cli.log_input import (
     parse_params,
     progress,
     read_log,
+    reversing_note,
 )
 from roverlab.geometry import SE2
 from roverlab.localization.amcl import (
@@ -154,14 +156,7 @@ def run(
     odom_frame: OdomFrameOption = "odom",
     base_frame: BaseFrameOption = None,
     first: FirstOption = None,
-    logged_odometry: Annotated[
-        bool,
-        typer.Option(
-            "--logged-odometry",
-            help="CARMEN logs: use the odometry poses as logged, without reversing the "
-            "steps that went forward while ODOM's velocity was negative.",
-        ),
-    ] = False,
+    logged_odometry: LoggedOdometryOption = False,
 ) -> None:
     """Localise a recorded log on MAP: DIR/trajectory.tum (robot pose in the map at every
     scan) and DIR/amcl.png (map, trajectory, particle clouds)."""
@@ -196,13 +191,9 @@ def run(
     read_s = time.monotonic() - started
     n = len(records)
     typer.echo(f"{n} scans from {log}; start: {source}", err=True)
-    if reversing is not None and reversing.reversed_steps:
-        typer.echo(
-            f"odometry: {reversing.reversed_steps} of {reversing.steps} steps moved forward "
-            "while the velocity was negative (reversing); they were reversed "
-            "(--logged-odometry: as logged)",
-            err=True,
-        )
+    note = reversing_note(reversing)
+    if note is not None:
+        typer.echo(note, err=True)
     snaps = sorted({-1, n // 3, (2 * n) // 3, n - 1})
     result = localize_log(progress(records, "amcl"), amcl, snapshot_at=snaps)
     wall = time.monotonic() - started

@@ -27,6 +27,7 @@ __all__ = [
     "BaseFrameOption",
     "FirstOption",
     "LogArgument",
+    "LoggedOdometryOption",
     "OdomFrameOption",
     "OdomTopicOption",
     "ParamOption",
@@ -35,6 +36,7 @@ __all__ = [
     "parse_params",
     "progress",
     "read_log",
+    "reversing_note",
 ]
 
 LogArgument = Annotated[
@@ -68,6 +70,25 @@ BaseFrameOption = Annotated[
 FirstOption = Annotated[
     int | None, typer.Option("--first", help="Use only the first N scans of the log.")
 ]
+LoggedOdometryOption = Annotated[
+    bool,
+    typer.Option(
+        "--logged-odometry",
+        help="CARMEN logs: use the odometry poses as logged, without reversing the "
+        "steps that went forward while ODOM's velocity was negative.",
+    ),
+]
+
+
+def reversing_note(reversing: ReversingRepair | None) -> str | None:
+    """What the odometry repair did, for stderr (None: nothing repaired)."""
+    if reversing is None or not reversing.reversed_steps:
+        return None
+    return (
+        f"odometry: {reversing.reversed_steps} of {reversing.steps} steps moved forward "
+        "while the velocity was negative (reversing); they were reversed "
+        "(--logged-odometry: as logged)"
+    )
 
 
 def progress(records: LaserLog, label: str) -> Iterator[ScanRecord]:

@@ -14,6 +14,7 @@ from roverlab.cli.log_input import (
     BaseFrameOption,
     FirstOption,
     LogArgument,
+    LoggedOdometryOption,
     OdomFrameOption,
     OdomTopicOption,
     ParamOption,
@@ -22,11 +23,13 @@ from roverlab.cli.log_input import (
     parse_params,
     progress,
     read_log,
+    reversing_note,
 )
 from roverlab.maps import save_map
 from roverlab.maps.plot import write_map_png
 from roverlab.slam.data.errors import SlamError
 from roverlab.slam.data.logs import LaserLog
+from roverlab.slam.data.reversing import ReversingRepair
 from roverlab.slam.data.trajectory import Trajectory, write_tum
 from roverlab.slam.gmapping import GMapping, GMappingParams
 from roverlab.slam.graph import GraphParams, GraphSLAM
@@ -47,6 +50,8 @@ def run_graph(records: LaserLog, params: dict[str, object]) -> MethodResult:
     m = result.map
     g = slam.graph()
     notes = [f"graph: {g.num_vertices} keyframes, {g.num_edges} constraints"]
+    if slam.rim_searches:
+        notes[0] += f", {slam.rim_searches} matches searched again beyond the angular window"
     dropped = sorted(k for k in params if k in NODE_PARAMETERS)
     if dropped:  # GraphParams.from_ros accepts slam_toolbox's node settings and drops them
         notes.append(
@@ -155,6 +160,7 @@ def run(
             "(what a live slam_gmapping reports).",
         ),
     ] = True,
+    logged_odometry: LoggedOdometryOption = False,
 ) -> None:
     """Map a recorded log: DIR/map.yaml + map.pgm, DIR/map.png, DIR/trajectory.tum."""
     if method not in METHODS:
@@ -168,6 +174,7 @@ def run(
     else:
         GraphParams.from_ros(params)
     started = time.monotonic()
+    reversing = None if logged_odometry else ReversingRepair()
     records = read_log(
         log,
         scan_topic=scan_topic,
@@ -177,8 +184,12 @@ def run(
         base_frame=base_frame,
         first=first,
         error=SlamError,
+        reversing=reversing,
     )
     typer.echo(f"{len(records)} scans from {log}", err=True)
+    note = reversing_note(reversing)
+    if note is not None:
+        typer.echo(note, err=True)
     if method == "hector":
         res = run_hector(records, params)
     elif method == "gmapping":

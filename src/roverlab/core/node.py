@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import difflib
+import heapq
 import threading
 from collections import deque
 from collections.abc import Callable, Iterable, Mapping
@@ -191,7 +192,8 @@ class _TimerFire:
         if nxt <= now:  # the clock jumped past whole periods: skip them, as rcl does
             nxt += ((now - nxt) // period + 1) * period
         timer._next_ns = nxt
-        ex.call_at(nxt, self)
+        entry: tuple[int, int, Callable[[], Any]] = (nxt, next(ex._seq), self)
+        heapq.heappush(ex._heap, entry)  # ex.call_at, inlined
         timer.callback()
 
 

@@ -22,6 +22,7 @@ JointStatePublisher
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from typing import Any
 
@@ -31,6 +32,7 @@ from roverlab.core import Context, Duration, Node, ParameterError, QoSProfile, T
 from roverlab.description.errors import DescriptionError
 from roverlab.description.model import Joint, JointType, RobotModel
 from roverlab.description.urdf import load_robot
+from roverlab.geometry import Transform3
 from roverlab.msgs import Header, JointState, String
 from roverlab.msgs import classes as mc
 from roverlab.tf import StaticTransformBroadcaster, TransformBroadcaster, transform_to_msg
@@ -38,6 +40,15 @@ from roverlab.tf import StaticTransformBroadcaster, TransformBroadcaster, transf
 __all__ = ["JointStatePublisher", "RobotStatePublisher"]
 
 _LATCHED = QoSProfile(depth=1, durability="transient_local")
+
+# parent frame, child frame, translation, origin rotation (x, y, z, w), axis
+_Revolute = tuple[
+    str,
+    str,
+    tuple[float, float, float],
+    tuple[float, float, float, float],
+    tuple[float, float, float],
+]
 
 
 def _robot(node: Node, robot_description: str | RobotModel | None) -> RobotModel:
@@ -107,6 +118,22 @@ class RobotStatePublisher(Node):
             if j.mimic is not None:
                 self._mimics.setdefault(j.mimic.joint, []).append(j)
         self._positions: dict[str, float] = {}
+        # revolute and continuous joints: frames, the translation and rotation of
+        # ``origin * motion(q)`` that do not depend on q, and the axis
+        self._revolute: dict[str, _Revolute] = {}
+        for j in self.model.movable_joints:
+            if j.type in (JointType.REVOLUTE, JointType.CONTINUOUS):
+                t = j.origin * Transform3((0.0, 0.0, 0.0), j.origin.rotation)
+                tx, ty, tz = (float(v) for v in t.translation)
+                ax, ay, az, aw = (float(v) for v in j.origin.rotation)
+                ux, uy, uz = (float(v) for v in j.axis)
+                self._revolute[j.name] = (
+                    self._frame(j.parent),
+                    self._frame(j.child),
+                    (tx, ty, tz),
+                    (ax, ay, az, aw),
+                    (ux, uy, uz),
+                )
         self._last_published: dict[str, int] = {}
         self._executor = context.executor
         self.publish_fixed_transforms()
@@ -119,6 +146,34 @@ class RobotStatePublisher(Node):
         return transform_to_msg(
             self._frame(joint.parent), self._frame(joint.child), stamp, joint.transform(position)
         )
+
+    def _revolute_msg(self, spec: _Revolute, sec: int, nanosec: int, position: float) -> Any:
+        """:meth:`_msg` of a revolute or continuous joint, the same numbers computed
+        without the intermediate transforms (this runs for every joint state)."""
+        parent, child, (tx, ty, tz), (ax, ay, az, aw), (ux, uy, uz) = spec
+        half = position / 2.0
+        s = math.sin(half)
+        bx, by, bz, bw = ux * s, uy * s, uz * s, math.cos(half)
+        return mc.TransformStamped(
+            mc.Header(mc.Time(sec, nanosec), parent),
+            child,
+            mc.Transform(
+                mc.Vector3(tx, ty, tz),
+                mc.Quaternion(
+                    aw * bx + ax * bw + ay * bz - az * by,
+                    aw * by - ax * bz + ay * bw + az * bx,
+                    aw * bz + ax * by - ay * bx + az * bw,
+                    aw * bw - ax * bx - ay * by - az * bz,
+                ),
+            ),
+        )
+
+    def _joint_msg(self, joint: Joint, stamp_ns: int, position: float) -> Any:
+        spec = self._revolute.get(joint.name)
+        if spec is None:
+            return self._msg(joint, Time(stamp_ns), position)
+        sec, nanosec = divmod(stamp_ns, 1_000_000_000)
+        return self._revolute_msg(spec, sec, nanosec, position)
 
     def publish_fixed_transforms(self) -> None:
         """(Re)publish every fixed joint on ``/tf_static``, stamped now."""
@@ -161,10 +216,9 @@ class RobotStatePublisher(Node):
         for name in names:
             self._last_published[name] = stamp_ns
         if updated:
-            stamp = Time(stamp_ns)
             self._tf.send_transform(
                 [
-                    self._msg(j, stamp, self.model.joint_position(j, self._positions))
+                    self._joint_msg(j, stamp_ns, self.model.joint_position(j, self._positions))
                     for j in updated.values()
                 ]
             )

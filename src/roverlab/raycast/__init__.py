@@ -4,8 +4,9 @@
 * :func:`cast_2d`, :func:`cast_2d_many`: exact planar laser ranges in a Scene.
 * :func:`cast_grid`, :func:`cast_grid_many`: exact planar ranges in an occupancy grid;
   :func:`grid_ray`, their compiled one-ray kernel, for other kernels.
-* :func:`render`: RGB + depth images of a pinhole camera; :func:`depth_to_points`,
-  :func:`optical_to_body`, :func:`body_to_optical` for point clouds.
+* :func:`render`: RGB + depth images of a pinhole camera (:func:`render_rgb`: RGB alone);
+  :func:`depth_to_points`, :func:`optical_to_body`, :func:`body_to_optical` for point
+  clouds.
 * :func:`scene_grid`: the uniform-grid accelerator every Scene kernel walks (cached).
 
 Kernels are ``numba.njit(cache=True, nogil=True)``: callers may run them from threads.
@@ -20,6 +21,7 @@ from roverlab.raycast.camera import (
     depth_to_points,
     optical_to_body,
     render,
+    render_rgb,
 )
 from roverlab.raycast.errors import RaycastError, RaycastInputError
 from roverlab.raycast.lidar import cast_2d, cast_2d_many, cast_grid, cast_grid_many, grid_ray
@@ -43,5 +45,6 @@ __all__ = [
     "grid_ray",
     "optical_to_body",
     "render",
+    "render_rgb",
     "scene_grid",
 ]

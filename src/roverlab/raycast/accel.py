@@ -41,6 +41,9 @@ __all__ = [
 #: walls never leak through it because of rounding.
 SEGMENT_PARAM_EPS = 1e-12
 
+# a numerator beyond ``best * den`` by this factor is surely behind (rounding included)
+_FAR_BEHIND = 1.0 + 1e-12
+
 _MAX_CELLS_PER_AXIS = 1024
 _MAX_CELLS = 1 << 20
 _CELLS_PER_PRIMITIVE = 2.0
@@ -130,7 +133,9 @@ def segment_distance(
     """:func:`segment_hit`'s distance if it is smaller than ``best``, else ``inf``.
 
     The lidar's inner test: it compares numerators against the determinant and divides
-    only for an accepted hit (same result as ``segment_hit(...)[0]``).
+    only for a hit that may be nearer than ``best`` (same result as
+    ``segment_hit(...)[0]``). The final test is on the distance itself, so the nearest
+    of several primitives is the same whatever order they are tested in.
     """
     ex = x1 - x0
     ey = y1 - y0
@@ -142,21 +147,23 @@ def segment_distance(
     if den > 0.0:
         if (
             nt < 0.0
-            or nt >= best * den
+            or nt >= best * den * _FAR_BEHIND
             or ns < -SEGMENT_PARAM_EPS * den
             or ns > (1.0 + SEGMENT_PARAM_EPS) * den
         ):
             return math.inf
-        return nt / den
+        t = nt / den
+        return t if t < best else math.inf
     if den < 0.0:
         if (
             nt > 0.0
-            or nt <= best * den
+            or nt <= best * den * _FAR_BEHIND
             or ns > -SEGMENT_PARAM_EPS * den
             or ns < (1.0 + SEGMENT_PARAM_EPS) * den
         ):
             return math.inf
-        return nt / den
+        t = nt / den
+        return t if t < best else math.inf
     t, _ = segment_hit(ox, oy, dx, dy, x0, y0, x1, y1)
     return t if t < best else math.inf
 

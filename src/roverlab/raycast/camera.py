@@ -39,7 +39,10 @@ import numba
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from roverlab.raycast.accel import circle_hit, grid_entry, scene_grid, segment_hit
+from roverlab.raycast.accel import scene_grid
+from roverlab.raycast.camera_fill import fill_pitched
+from roverlab.raycast.camera_hits import MAX_LAYERS, collect_hits
+from roverlab.raycast.camera_level import fill_level
 from roverlab.raycast.errors import RaycastInputError
 from roverlab.raycast.scene import Scene
 
@@ -51,21 +54,11 @@ __all__ = [
     "depth_to_points",
     "optical_to_body",
     "render",
+    "render_rgb",
 ]
-
-#: Surfaces kept per image column, nearest first. Surfaces behind one that covers the
-#: whole column are dropped; past this many, the farthest are (then unseen).
-MAX_LAYERS = 8
 
 _jit = numba.njit(cache=True, nogil=True)
 
-_LIGHT_AZIMUTH = 0.9  # rad, fixed world direction of the light
-_AMBIENT = 0.6
-_DIFFUSE = 0.4
-_FALLOFF = 0.03  # per metre: shade /= 1 + falloff * distance
-_MIN_FALLOFF = 0.55
-_FLOOR_DARK = 0.88  # odd checker tiles
-_CAP_SHADE = 1.08
 _TEX_CACHE_ATTR = "_raycast_textures"
 
 
@@ -109,571 +102,6 @@ def camera_intrinsics(width: int, height: int, hfov: float) -> CameraIntrinsics:
 
 
 @_jit
-def _shade(nx: float, ny: float, dist: float) -> float:
-    lx = math.cos(_LIGHT_AZIMUTH)
-    ly = math.sin(_LIGHT_AZIMUTH)
-    s = _AMBIENT + _DIFFUSE * abs(nx * lx + ny * ly)
-    return s * max(_MIN_FALLOFF, 1.0 / (1.0 + _FALLOFF * dist))
-
-
-@_jit
-def _to_u8(v: float) -> np.uint8:
-    return np.uint8(min(255.0, max(0.0, v + 0.5)))
-
-
-@_jit
-def _row_ceil(val: float, n: int) -> int:
-    """``ceil(val)`` clamped to [-1, n] (safe for huge or infinite values)."""
-    return int(math.ceil(min(max(val, -1.0), float(n))))
-
-
-@_jit
-def _row_floor(val: float, n: int) -> int:
-    """``floor(val)`` clamped to [-1, n]."""
-    return int(math.floor(min(max(val, -1.0), float(n))))
-
-
-@_jit
-def _collect_hits(
-    x: float,
-    y: float,
-    z: float,
-    yaw: float,
-    n_az: int,
-    q0: float,
-    dq: float,
-    el_top: float,
-    el_bot: float,
-    hx_max: float,
-    far: float,
-    segs: NDArray[np.float64],
-    segz: NDArray[np.float64],
-    circs: NDArray[np.float64],
-    circz: NDArray[np.float64],
-    gx0: float,
-    gy0: float,
-    cell: float,
-    nx: int,
-    ny: int,
-    cstart: NDArray[np.int32],
-    items: NDArray[np.int32],
-    nseg: int,
-    segrgb: NDArray[np.uint8],
-    circrgb: NDArray[np.uint8],
-) -> tuple[
-    NDArray[np.float64],
-    NDArray[np.float64],
-    NDArray[np.int64],
-    NDArray[np.float64],
-    NDArray[np.float64],
-    NDArray[np.int64],
-    NDArray[np.float64],
-    NDArray[np.float64],
-    NDArray[np.uint8],
-]:
-    """The MAX_LAYERS nearest surfaces along each azimuth sample ``q_k = q0 - k * dq``.
-
-    ``q`` is the tangent of the azimuth relative to ``yaw``; ``el_top``/``el_bot`` the
-    tangents of the elevations of the top and bottom image rows in the camera's vertical
-    plane; ``hx_max`` the largest horizontal ray length per unit depth at ``q = 0``.
-    Per surface: entry and exit distances, primitive item, texture ``u``, shade and the
-    shaded colours of its side (``[..., 0:3]``) and cap (``[..., 3:6]``).
-    """
-    nk = MAX_LAYERS
-    floor_seen = z > 0.0
-    az_dx = np.empty(n_az)
-    az_dy = np.empty(n_az)
-    n_hits = np.zeros(n_az, dtype=np.int64)
-    h_in = np.empty((n_az, nk))
-    h_out = np.empty((n_az, nk))
-    h_id = np.empty((n_az, nk), dtype=np.int64)
-    h_u = np.empty((n_az, nk))
-    h_shade = np.empty((n_az, nk))
-    h_rgb = np.empty((n_az, nk, 6), dtype=np.uint8)
-    for u in range(n_az):
-        q = q0 - u * dq
-        root = math.sqrt(1.0 + q * q)
-        psi = yaw + math.atan(q)
-        dx = math.cos(psi)
-        dy = math.sin(psi)
-        az_dx[u] = dx
-        az_dy[u] = dy
-        # height slopes (dz per horizontal metre) of the highest and lowest rows, and the
-        # horizontal distance beyond which every pixel's depth exceeds far
-        s_top = max(el_top, el_bot) / root
-        s_bot = min(el_top, el_bot) / root
-        hmax = far * hx_max * root
-
-        t0, ix, iy = grid_entry(x, y, dx, dy, gx0, gy0, cell, nx, ny)
-        n = 0
-        block = math.inf
-        if t0 <= hmax:
-            stepx = 1 if dx > 0.0 else (-1 if dx < 0.0 else 0)
-            stepy = 1 if dy > 0.0 else (-1 if dy < 0.0 else 0)
-            offx = 1 if dx > 0.0 else 0
-            offy = 1 if dy > 0.0 else 0
-            invdx = 1.0 / dx if dx != 0.0 else 0.0
-            invdy = 1.0 / dy if dy != 0.0 else 0.0
-            while True:
-                tmx = (gx0 + (ix + offx) * cell - x) * invdx if stepx != 0 else math.inf
-                tmy = (gy0 + (iy + offy) * cell - y) * invdy if stepy != 0 else math.inf
-                texit = min(tmx, tmy)
-                c = iy * nx + ix
-                for k in range(cstart[c], cstart[c + 1]):
-                    it = items[k]
-                    if it < nseg:
-                        t, su = segment_hit(
-                            x, y, dx, dy, segs[it, 0], segs[it, 1], segs[it, 2], segs[it, 3]
-                        )
-                        tout = t
-                        zmin = segz[it, 0]
-                        zmax = segz[it, 1]
-                    else:
-                        j = it - nseg
-                        t, tout = circle_hit(x, y, dx, dy, circs[j, 0], circs[j, 1], circs[j, 2])
-                        su = 0.0
-                        zmin = circz[j, 0]
-                        zmax = circz[j, 1]
-                    if t > hmax or t > block or (n == nk and t >= h_in[u, nk - 1]):
-                        continue
-                    dup = False
-                    for m in range(n):
-                        if h_id[u, m] == it:
-                            dup = True
-                            break
-                    if dup:
-                        continue
-                    # insertion into the sorted list (the farthest drops out when full)
-                    pos = n if n < nk else nk - 1
-                    while pos > 0 and h_in[u, pos - 1] > t:
-                        h_in[u, pos] = h_in[u, pos - 1]
-                        h_out[u, pos] = h_out[u, pos - 1]
-                        h_id[u, pos] = h_id[u, pos - 1]
-                        h_u[u, pos] = h_u[u, pos - 1]
-                        pos -= 1
-                    h_in[u, pos] = t
-                    h_out[u, pos] = tout
-                    h_id[u, pos] = it
-                    h_u[u, pos] = su
-                    if n < nk:
-                        n += 1
-                    # covers every row of the image at this distance: nothing behind shows
-                    zhi = z + s_top * t
-                    zlo = z + s_bot * t
-                    if floor_seen:
-                        zlo = max(zlo, 0.0)
-                    if zmin <= zlo and zmax >= zhi:
-                        block = t
-                        n = pos + 1
-                if block <= texit or (n == nk and h_in[u, nk - 1] <= texit) or texit > hmax:
-                    break
-                if tmx < tmy:
-                    ix += stepx
-                    if ix < 0 or ix >= nx:
-                        break
-                else:
-                    iy += stepy
-                    if iy < 0 or iy >= ny:
-                        break
-        n_hits[u] = n
-        for m in range(n):
-            it = h_id[u, m]
-            t = h_in[u, m]
-            if it < nseg:
-                ex = segs[it, 2] - segs[it, 0]
-                ey = segs[it, 3] - segs[it, 1]
-                el = math.sqrt(ex * ex + ey * ey)
-                sh = _shade(-ey / el, ex / el, t) if el > 0.0 else _shade(-dx, -dy, t)
-                for ch in range(3):
-                    h_rgb[u, m, ch] = _to_u8(segrgb[it, ch] * sh)
-                    h_rgb[u, m, 3 + ch] = h_rgb[u, m, ch]
-            else:
-                j = it - nseg
-                r = circs[j, 2]
-                if t > 0.0 and r > 0.0:
-                    px = x + t * dx - circs[j, 0]
-                    py = y + t * dy - circs[j, 1]
-                    sh = _shade(px / r, py / r, t)
-                else:
-                    sh = _shade(-dx, -dy, t)
-                for ch in range(3):
-                    h_rgb[u, m, ch] = _to_u8(circrgb[j, ch] * sh)
-                    h_rgb[u, m, 3 + ch] = _to_u8(circrgb[j, ch] * sh * _CAP_SHADE)
-            h_shade[u, m] = sh
-    return az_dx, az_dy, n_hits, h_in, h_out, h_id, h_u, h_shade, h_rgb
-
-
-@_jit
-def _put_sky(
-    rgb: NDArray[np.uint8], depth: NDArray[np.float32], v: int, u: int, sky: NDArray[np.uint8]
-) -> None:
-    rgb[v, u, 0] = sky[0]
-    rgb[v, u, 1] = sky[1]
-    rgb[v, u, 2] = sky[2]
-    depth[v, u] = np.nan
-
-
-@_jit
-def _texel(
-    tex_data: NDArray[np.uint8],
-    tex_off: NDArray[np.int64],
-    tex_shape: NDArray[np.int64],
-    ti: int,
-    tu: float,
-    tv: float,
-) -> int:
-    """Row of ``tex_data`` holding texture ``ti`` at ``(u, v)`` in [0, 1]^2."""
-    th = tex_shape[ti, 0]
-    tw = tex_shape[ti, 1]
-    row = min(max(int(tv * th), 0), th - 1)
-    col = min(max(int(tu * tw), 0), tw - 1)
-    return int(tex_off[ti] + row * tw + col)
-
-
-@_jit
-def _floor_factor(wx: float, wy: float) -> float:
-    return 1.0 if ((int(math.floor(wx)) + int(math.floor(wy))) & 1) == 0 else _FLOOR_DARK
-
-
-_EMPTY = -1  # owner of a pixel that sees the floor or the sky
-
-
-@_jit
-def _fill_level(
-    x: float,
-    y: float,
-    z: float,
-    yaw: float,
-    fx: float,
-    fy: float,
-    cx: float,
-    cy: float,
-    near: float,
-    far: float,
-    segz: NDArray[np.float64],
-    segtex: NDArray[np.int32],
-    circz: NDArray[np.float64],
-    tex_data: NDArray[np.uint8],
-    tex_off: NDArray[np.int64],
-    tex_shape: NDArray[np.int64],
-    floor_rgb: NDArray[np.uint8],
-    sky_rgb: NDArray[np.uint8],
-    nseg: int,
-    n_hits: NDArray[np.int64],
-    h_in: NDArray[np.float64],
-    h_out: NDArray[np.float64],
-    h_id: NDArray[np.int64],
-    h_u: NDArray[np.float64],
-    h_shade: NDArray[np.float64],
-    h_rgb: NDArray[np.uint8],
-    rgb: NDArray[np.uint8],
-    depth: NDArray[np.float32],
-) -> None:
-    """Level camera: each column is one vertical plane, so each surface covers a row span.
-
-    Pixel ``(u, v)`` has slope ``s = b / L`` (``b = (cy - v) / fy``,
-    ``L = sqrt(1 + a^2)``, ``a = (cx - u) / fx``): a surface at horizontal distance ``t``
-    spanning ``[zlo, zmax]`` covers the rows with ``b`` in ``[(zlo - z) L / t,
-    (zmax - z) L / t]``; the floor seen by row ``v`` is at depth ``-z / b``. First, per
-    column, the spans are painted near to far into ``own`` (surface ``m``, cap
-    ``MAX_LAYERS + m`` or ``_EMPTY`` for floor or sky) and kept as runs of rows; then
-    the image is written row by row, each column advancing through its runs.
-    """
-    height, width = depth.shape
-    nk = MAX_LAYERS
-    floor_seen = z > 0.0
-    nan32 = np.float32(np.nan)
-    own = np.empty(height, dtype=np.int8)
-    max_runs = 4 * nk + 4  # <= 2 spans per surface, each splitting at most one run
-    run_end = np.empty((width, max_runs), dtype=np.int32)  # last row of each run
-    run_own = np.empty((width, max_runs), dtype=np.int8)
-    h_depth = np.empty((width, nk), dtype=np.float32)
-    h_tex = np.full((width, nk), -1, dtype=np.int64)  # texture index of textured walls
-    h_col = np.zeros((width, nk), dtype=np.int64)  # and the texture column they show
-    h_zc = np.zeros((width, nk))  # height of the cap a cylinder shows
-
-    # ---- per column: which surface each row sees ----
-    for u in range(width):
-        a = (cx - u) / fx
-        big_l = math.sqrt(1.0 + a * a)
-        invl = 1.0 / big_l
-        own[:] = _EMPTY
-        for m in range(n_hits[u]):
-            t = h_in[u, m]
-            d = t * invl
-            if d > far:
-                break
-            h_depth[u, m] = d if d >= near else nan32
-            it = h_id[u, m]
-            if it < nseg:
-                zmin = segz[it, 0]
-                zmax = segz[it, 1]
-                ti = segtex[it]
-                if ti >= 0:
-                    tw = tex_shape[ti, 1]
-                    h_tex[u, m] = ti
-                    h_col[u, m] = min(max(int(h_u[u, m] * tw), 0), tw - 1)
-            else:
-                zmin = circz[it - nseg, 0]
-                zmax = circz[it - nseg, 1]
-                h_zc[u, m] = zmax if z > zmax else zmin
-            zlo = max(zmin, 0.0) if floor_seen else zmin
-            # side face
-            if zlo <= zmax:
-                if t > 0.0:
-                    v0 = _row_ceil(cy - fy * (zmax - z) * big_l / t, height)
-                    v1 = _row_floor(cy - fy * (zlo - z) * big_l / t, height)
-                elif zlo <= z <= zmax:
-                    v0 = 0
-                    v1 = height - 1
-                else:
-                    v0 = 0
-                    v1 = -1
-                for v in range(max(v0, 0), min(v1, height - 1) + 1):
-                    if own[v] == _EMPTY:
-                        own[v] = m
-            if it < nseg:
-                continue
-            # cylinder caps, seen between the entry and exit distances
-            tout = h_out[u, m]
-            if z > zmax and (zmax >= 0.0 or not floor_seen):
-                # top: rows with s in ((zmax - z) / t, (zmax - z) / tout]
-                v0 = _row_ceil(cy - fy * (zmax - z) * big_l / tout, height)
-                if t > 0.0:
-                    v1 = _row_ceil(cy - fy * (zmax - z) * big_l / t, height) - 1
-                else:
-                    v1 = height - 1
-                for v in range(max(v0, 0), min(v1, height - 1) + 1):
-                    if own[v] == _EMPTY:
-                        own[v] = nk + m
-            if z < zmin:
-                # bottom: rows with s in [(zmin - z) / tout, (zmin - z) / t)
-                v0 = _row_floor(cy - fy * (zmin - z) * big_l / t, height) + 1 if t > 0.0 else 0
-                v1 = _row_floor(cy - fy * (zmin - z) * big_l / tout, height)
-                for v in range(max(v0, 0), min(v1, height - 1) + 1):
-                    if own[v] == _EMPTY:
-                        own[v] = nk + m
-        r = 0
-        for v in range(1, height):
-            if own[v] != own[v - 1]:
-                run_end[u, r] = v - 1
-                run_own[u, r] = own[v - 1]
-                r += 1
-        run_end[u, r] = height - 1
-        run_own[u, r] = own[height - 1]
-
-    # ---- row by row: colours and depths ----
-    cur = np.zeros(width, dtype=np.int64)
-    cur_end = np.empty(width, dtype=np.int32)
-    cur_own = np.empty(width, dtype=np.int8)
-    for u in range(width):
-        cur_end[u] = run_end[u, 0]
-        cur_own[u] = run_own[u, 0]
-    floor_cols = np.empty((2, 3), dtype=np.uint8)
-    for ch in range(3):
-        floor_cols[0, ch] = floor_rgb[ch]
-        floor_cols[1, ch] = _to_u8(floor_rgb[ch] * _FLOOR_DARK)
-    cyaw = math.cos(yaw)
-    syaw = math.sin(yaw)
-    for v in range(height):
-        b = (cy - v) / fy
-        fd = -z / b if (floor_seen and b < 0.0) else math.inf
-        floor_ok = fd <= far
-        fdo = np.float32(fd) if (floor_ok and fd >= near) else nan32
-        # the floor point of pixel u is (x, y) + fd * R(yaw) (1, a_u): linear in u
-        fwx = x + fd * (cyaw - syaw * cx / fx) if floor_ok else 0.0
-        fwy = y + fd * (syaw + cyaw * cx / fx) if floor_ok else 0.0
-        gwx = fd * syaw / fx if floor_ok else 0.0
-        gwy = -fd * cyaw / fx if floor_ok else 0.0
-        for u in range(width):
-            if v > cur_end[u]:
-                k = cur[u] + 1
-                cur[u] = k
-                cur_end[u] = run_end[u, k]
-                cur_own[u] = run_own[u, k]
-            o = cur_own[u]
-            if o == _EMPTY:
-                if floor_ok:
-                    k = (int(math.floor(fwx + u * gwx)) + int(math.floor(fwy + u * gwy))) & 1
-                    rgb[v, u, 0] = floor_cols[k, 0]
-                    rgb[v, u, 1] = floor_cols[k, 1]
-                    rgb[v, u, 2] = floor_cols[k, 2]
-                    depth[v, u] = fdo
-                else:
-                    rgb[v, u, 0] = sky_rgb[0]
-                    rgb[v, u, 1] = sky_rgb[1]
-                    rgb[v, u, 2] = sky_rgb[2]
-                    depth[v, u] = nan32
-            elif o < nk:
-                depth[v, u] = h_depth[u, o]
-                ti = h_tex[u, o]
-                if ti >= 0:
-                    it = h_id[u, o]
-                    zmin = segz[it, 0]
-                    zmax = segz[it, 1]
-                    zt = z + b * h_in[u, o] / math.sqrt(1.0 + ((cx - u) / fx) ** 2)
-                    th = tex_shape[ti, 0]
-                    tv = (zmax - zt) / (zmax - zmin) if zmax > zmin else 0.0
-                    row = min(max(int(tv * th), 0), th - 1)
-                    p = tex_off[ti] + row * tex_shape[ti, 1] + h_col[u, o]
-                    sh = h_shade[u, o]
-                    rgb[v, u, 0] = _to_u8(tex_data[p, 0] * sh)
-                    rgb[v, u, 1] = _to_u8(tex_data[p, 1] * sh)
-                    rgb[v, u, 2] = _to_u8(tex_data[p, 2] * sh)
-                else:
-                    rgb[v, u, 0] = h_rgb[u, o, 0]
-                    rgb[v, u, 1] = h_rgb[u, o, 1]
-                    rgb[v, u, 2] = h_rgb[u, o, 2]
-            else:
-                m = o - nk
-                dc = (h_zc[u, m] - z) / b
-                if dc <= far:
-                    rgb[v, u, 0] = h_rgb[u, m, 3]
-                    rgb[v, u, 1] = h_rgb[u, m, 4]
-                    rgb[v, u, 2] = h_rgb[u, m, 5]
-                    depth[v, u] = dc if dc >= near else nan32
-                else:
-                    rgb[v, u, 0] = sky_rgb[0]
-                    rgb[v, u, 1] = sky_rgb[1]
-                    rgb[v, u, 2] = sky_rgb[2]
-                    depth[v, u] = nan32
-
-
-@_jit
-def _fill_pitched(
-    x: float,
-    y: float,
-    z: float,
-    pitch: float,
-    fx: float,
-    fy: float,
-    cx: float,
-    cy: float,
-    near: float,
-    far: float,
-    q0: float,
-    dq: float,
-    segz: NDArray[np.float64],
-    segtex: NDArray[np.int32],
-    circz: NDArray[np.float64],
-    tex_data: NDArray[np.uint8],
-    tex_off: NDArray[np.int64],
-    tex_shape: NDArray[np.int64],
-    floor_rgb: NDArray[np.uint8],
-    sky_rgb: NDArray[np.uint8],
-    nseg: int,
-    az_dx: NDArray[np.float64],
-    az_dy: NDArray[np.float64],
-    n_hits: NDArray[np.int64],
-    h_in: NDArray[np.float64],
-    h_out: NDArray[np.float64],
-    h_id: NDArray[np.int64],
-    h_u: NDArray[np.float64],
-    h_shade: NDArray[np.float64],
-    h_rgb: NDArray[np.uint8],
-    rgb: NDArray[np.uint8],
-    depth: NDArray[np.float32],
-) -> None:
-    """Tilted camera: per pixel, walk the surfaces of the nearest azimuth sample."""
-    height, width = depth.shape
-    n_az = n_hits.shape[0]
-    ct = math.cos(pitch)
-    st = math.sin(pitch)
-    floor_seen = z > 0.0
-    nan32 = np.float32(np.nan)
-    floor_cols = np.empty((2, 3), dtype=np.uint8)
-    for ch in range(3):
-        floor_cols[0, ch] = floor_rgb[ch]
-        floor_cols[1, ch] = _to_u8(floor_rgb[ch] * _FLOOR_DARK)
-    # per azimuth sample: 1 / sqrt(1 + q^2); the horizontal length of a pixel's ray per
-    # unit depth is hx * sqrt(1 + q^2), taken at the sample the pixel uses
-    inv_root = np.empty(n_az)
-    root = np.empty(n_az)
-    for k in range(n_az):
-        q = q0 - k * dq
-        root[k] = math.sqrt(1.0 + q * q)
-        inv_root[k] = 1.0 / root[k]
-    inv_dq = 1.0 / dq
-    for v in range(height):
-        b = (cy - v) / fy
-        hx = ct + b * st
-        vz = -st + b * ct
-        inv_hx = 1.0 / hx
-        slope = vz * inv_hx  # height gained per horizontal metre, times sqrt(1 + q^2)
-        # the floor: same z-depth -z / vz across the row, at horizontal distance
-        # (-z / vz) * hx * sqrt(1 + q^2)
-        floor_row = -z / vz * hx if (floor_seen and vz < 0.0) else math.inf
-        for px in range(width):
-            a = (cx - px) / fx
-            u = min(max(int((q0 - a * inv_hx) * inv_dq + 0.5), 0), n_az - 1)
-            invl = inv_hx * inv_root[u]
-            s = slope * inv_root[u]
-            hfloor = floor_row * root[u]
-            d = math.inf
-            c0 = sky_rgb[0]
-            c1 = sky_rgb[1]
-            c2 = sky_rgb[2]
-            for m in range(n_hits[u]):
-                t = h_in[u, m]
-                if t > hfloor:
-                    break
-                it = h_id[u, m]
-                zt = z + s * t
-                if it < nseg:
-                    zmin = segz[it, 0]
-                    zmax = segz[it, 1]
-                    if zt < zmin or zt > zmax:
-                        continue
-                    ti = segtex[it]
-                    if ti >= 0:
-                        sh = h_shade[u, m]
-                        tv = (zmax - zt) / (zmax - zmin) if zmax > zmin else 0.0
-                        p = _texel(tex_data, tex_off, tex_shape, ti, h_u[u, m], tv)
-                        c0 = _to_u8(tex_data[p, 0] * sh)
-                        c1 = _to_u8(tex_data[p, 1] * sh)
-                        c2 = _to_u8(tex_data[p, 2] * sh)
-                    else:
-                        c0 = h_rgb[u, m, 0]
-                        c1 = h_rgb[u, m, 1]
-                        c2 = h_rgb[u, m, 2]
-                    d = t * invl
-                    break
-                zmin = circz[it - nseg, 0]
-                zmax = circz[it - nseg, 1]
-                if zmin <= zt <= zmax:
-                    d = t * invl
-                    c0 = h_rgb[u, m, 0]
-                    c1 = h_rgb[u, m, 1]
-                    c2 = h_rgb[u, m, 2]
-                    break
-                if zt > zmax and s < 0.0 and (zmax - z) / s <= h_out[u, m]:
-                    d = (zmax - z) / s * invl
-                elif zt < zmin and s > 0.0 and (zmin - z) / s <= h_out[u, m]:
-                    d = (zmin - z) / s * invl
-                else:
-                    continue
-                c0 = h_rgb[u, m, 3]
-                c1 = h_rgb[u, m, 4]
-                c2 = h_rgb[u, m, 5]
-                break
-            if d == math.inf and hfloor < math.inf:
-                k = (
-                    int(math.floor(x + hfloor * az_dx[u])) + int(math.floor(y + hfloor * az_dy[u]))
-                ) & 1
-                c0 = floor_cols[k, 0]
-                c1 = floor_cols[k, 1]
-                c2 = floor_cols[k, 2]
-                d = hfloor * invl
-            if d <= far:
-                rgb[v, px, 0] = c0
-                rgb[v, px, 1] = c1
-                rgb[v, px, 2] = c2
-                depth[v, px] = d if d >= near else nan32
-            else:
-                _put_sky(rgb, depth, v, px, sky_rgb)
-
-
-@_jit
 def _render_kernel(
     x: float,
     y: float,
@@ -708,8 +136,9 @@ def _render_kernel(
     nseg: int,
     rgb: NDArray[np.uint8],
     depth: NDArray[np.float32],
+    with_depth: bool,
 ) -> None:
-    width = depth.shape[1]
+    width = rgb.shape[1]
     ct = math.cos(pitch)
     st = math.sin(pitch)
     # image rows in the camera's vertical plane: direction (hx, 0, vz) per unit depth
@@ -734,20 +163,20 @@ def _render_kernel(
         if (n_az - width) % 2 != 0:
             n_az += 1  # same parity as the width: an odd image keeps its centre sample
         dq = 2.0 * q0 / max(n_az - 1, 1)
-    az_dx, az_dy, n_hits, h_in, h_out, h_id, h_u, h_shade, h_rgb = _collect_hits(
+    az_dx, az_dy, n_hits, h_in, h_out, h_id, h_u, h_shade, h_rgb = collect_hits(
         x, y, z, yaw, n_az, q0, dq, el_top, el_bot, hx_max, far,
         segs, segz, circs, circz, gx0, gy0, cell, nx, ny, cstart, items, nseg,
         segrgb, circrgb,
     )  # fmt: skip
     if pitch == 0.0:
-        _fill_level(
+        fill_level(
             x, y, z, yaw, fx, fy, cx, cy, near, far,
             segz, segtex, circz, tex_data, tex_off, tex_shape,
             floor_rgb, sky_rgb, nseg,
-            n_hits, h_in, h_out, h_id, h_u, h_shade, h_rgb, rgb, depth,
+            n_hits, h_in, h_out, h_id, h_u, h_shade, h_rgb, rgb, depth, with_depth,
         )  # fmt: skip
     else:
-        _fill_pitched(
+        fill_pitched(
             x, y, z, pitch, fx, fy, cx, cy, near, far, q0, dq,
             segz, segtex, circz, tex_data, tex_off, tex_shape,
             floor_rgb, sky_rgb, nseg,
@@ -825,7 +254,65 @@ def render(
         RaycastInputError: non-finite pose, bad size, field of view, clip range or pitch.
     """
     intr = camera_intrinsics(width, height, hfov)
-    vals = [float(v) for v in (x, y, z, yaw, pitch)]
+    depth = np.empty((intr.height, intr.width), dtype=np.float32)
+    rgb = _render(scene, (x, y, z, yaw, pitch), intr, near, far, None, depth)
+    return rgb, depth
+
+
+def render_rgb(
+    scene: Scene,
+    x: float,
+    y: float,
+    z: float,
+    yaw: float,
+    *,
+    hfov: float,
+    width: int,
+    height: int,
+    near: float,
+    far: float,
+    pitch: float = 0.0,
+    out: NDArray[np.uint8] | None = None,
+) -> NDArray[np.uint8]:
+    """:func:`render`'s RGB image alone (a level camera then skips the depth image).
+
+    Args:
+        out: an (H, W, 3) C-contiguous uint8 array to render into (every pixel is
+            written), or None for a new one.
+
+    Raises:
+        RaycastInputError: as :func:`render`; an ``out`` of another shape or type.
+    """
+    intr = camera_intrinsics(width, height, hfov)
+    if out is not None and (
+        out.shape != (intr.height, intr.width, 3)
+        or out.dtype != np.uint8
+        or not out.flags.c_contiguous
+    ):
+        raise RaycastInputError(
+            f"out must be a C-contiguous ({intr.height}, {intr.width}, 3) uint8 array, "
+            f"got {out.dtype} {out.shape}"
+        )
+    level = float(pitch) == 0.0
+    depth = _NO_DEPTH if level else np.empty((intr.height, intr.width), dtype=np.float32)
+    return _render(scene, (x, y, z, yaw, pitch), intr, near, far, out, depth)
+
+
+_NO_DEPTH = np.zeros((1, 1), dtype=np.float32)
+
+
+def _render(
+    scene: Scene,
+    pose: tuple[float, float, float, float, float],
+    intr: CameraIntrinsics,
+    near: float,
+    far: float,
+    out: NDArray[np.uint8] | None,
+    depth: NDArray[np.float32],
+) -> NDArray[np.uint8]:
+    """Validate and render into ``out`` (or a new image); ``depth`` is filled unless it
+    is ``_NO_DEPTH`` (a level camera only)."""
+    vals = [float(v) for v in pose]
     if not all(math.isfinite(v) for v in vals):
         raise RaycastInputError(f"camera pose must be finite, got {vals}")
     x_, y_, z_, yaw_, pitch_ = vals
@@ -839,8 +326,7 @@ def render(
         )
     g = scene_grid(scene)
     tex_data, tex_off, tex_shape = _packed_textures(scene)
-    rgb = np.empty((intr.height, intr.width, 3), dtype=np.uint8)
-    depth = np.empty((intr.height, intr.width), dtype=np.float32)
+    rgb = np.empty((intr.height, intr.width, 3), dtype=np.uint8) if out is None else out
     _render_kernel(
         x_, y_, z_, yaw_, pitch_, intr.fx, intr.fy, intr.cx, intr.cy, near_, far_,
         scene.segments, scene.segment_z, scene.segment_rgb, scene.segment_texture,
@@ -848,9 +334,9 @@ def render(
         tex_data, tex_off, tex_shape,
         _rgb3("floor_rgb", scene.floor_rgb), _rgb3("sky_rgb", scene.sky_rgb),
         g.x0, g.y0, g.cell, g.nx, g.ny, g.cell_start, g.items, g.n_segments,
-        rgb, depth,
+        rgb, depth, depth is not _NO_DEPTH,
     )  # fmt: skip
-    return rgb, depth
+    return rgb
 
 
 def depth_to_points(

@@ -23,6 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 from roverlab.raycast.accel import Grid, circle_hit, grid_entry, scene_grid, segment_distance
 from roverlab.raycast.errors import RaycastInputError
 from roverlab.raycast.scene import Scene
+from roverlab.raycast.sweep import SWEEP_MAX_PRIMITIVES_PER_BEAM, fan_step, sweep_fan
 
 __all__ = ["cast_2d", "cast_2d_many", "cast_grid", "cast_grid_many", "grid_ray"]
 
@@ -118,6 +119,11 @@ def _cast_2d_kernel(
     n = angles.shape[0]
     ca = np.cos(angles)
     sa = np.sin(angles)
+    # a uniform fan in a small scene: the angular sweep (same ranges, see .sweep)
+    step = fan_step(angles)
+    sweep = step > 0.0 and segs.shape[0] + circs.shape[0] <= SWEEP_MAX_PRIMITIVES_PER_BEAM * n
+    dxs = np.empty(n)
+    dys = np.empty(n)
     for p in range(poses.shape[0]):
         ox = poses[p, 0]
         oy = poses[p, 1]
@@ -126,13 +132,18 @@ def _cast_2d_kernel(
         sy = math.sin(yaw)
         for i in range(n):
             if yaw == 0.0:
-                dx = ca[i]
-                dy = sa[i]
+                dxs[i] = ca[i]
+                dys[i] = sa[i]
             else:
-                dx = cy * ca[i] - sy * sa[i]
-                dy = sy * ca[i] + cy * sa[i]
+                dxs[i] = cy * ca[i] - sy * sa[i]
+                dys[i] = sy * ca[i] + cy * sa[i]
+        if sweep:
+            sweep_fan(ox, oy, z, yaw + angles[0], step, dxs, dys, rmax,
+                      segs, segz, circs, circz, out[p])  # fmt: skip
+            continue
+        for i in range(n):
             out[p, i] = _cast_ray(
-                ox, oy, dx, dy, z, rmax, segs, segz, circs, circz,
+                ox, oy, dxs[i], dys[i], z, rmax, segs, segz, circs, circz,
                 gx0, gy0, cell, nx, ny, cstart, items, nseg,
             )  # fmt: skip
 

@@ -43,6 +43,7 @@ from roverlab.sim.dynamics import (
     S_Y,
     STATE_SIZE,
     advance,
+    compiled_entry,
 )
 from roverlab.sim.sensors import CameraModel, ImuModel, LidarModel
 from roverlab.tf import TransformBroadcaster
@@ -172,6 +173,19 @@ class SimulatorNode(Node):
                 inner_radius(self._footprint),
             ]
         )
+        self._dt = self._step_ns / 1e9
+        self._advance = compiled_entry(
+            advance,
+            self._state,
+            self._params,
+            0,
+            self._dt,
+            self._footprint,
+            self.obstacles.segments,
+            self.obstacles.circles,
+            self._noise,
+            0,
+        )
         self.tf = TransformBroadcaster(self)
         self._mounts: dict[int, tuple[float, float, float, float, float]] = {}
         if self.drive is not None:
@@ -244,11 +258,11 @@ class SimulatorNode(Node):
             self._noise_pos = 0
         while steps > 0:
             chunk = min(steps, self._slip_block - self._noise_pos)
-            self._noise_pos = advance(
+            self._noise_pos = self._advance(
                 self._state,
                 self._params,
                 chunk,
-                self._step_ns / 1e9,
+                self._dt,
                 self._footprint,
                 self.obstacles.segments,
                 self.obstacles.circles,
@@ -302,32 +316,49 @@ class SimulatorNode(Node):
     def _publish_odometry(self) -> None:
         d = self.drive
         assert d is not None
-        ns = self.get_clock().now_ns()
+        ns = self._executor.now_ns  # a timer callback: the event's time
         x, y, yaw = self.odometry_pose()
-        st = self._state
+        st = self._state.tolist()
         if d.odometry_source == "encoder":
             v = 0.5 * (st[S_VL] + st[S_VR])
             w = (st[S_VR] - st[S_VL]) / d.params.wheel_separation_m
         else:
-            v, w = self.v, self.w
+            v, w = st[S_V], st[S_W]
+        sec, nsec = divmod(ns, 1_000_000_000)
+        half = 0.5 * yaw
+        qz, qw = math.sin(half), math.cos(half)
         self.odom_pub.publish(
             mc.Odometry(
-                _header(ns, d.odometry_frame),
+                mc.Header(mc.Time(sec, nsec), d.odometry_frame),
                 d.robot_base_frame,
-                _pose_msg(x, y, yaw, self._pose_cov),
-                _twist_msg(v, w, self._twist_cov),
+                mc.PoseWithCovariance(
+                    mc.Pose(mc.Point(x, y, 0.0), mc.Quaternion(0.0, 0.0, qz, qw)), self._pose_cov
+                ),
+                mc.TwistWithCovariance(
+                    mc.Twist(mc.Vector3(v, 0.0, 0.0), mc.Vector3(0.0, 0.0, w)), self._twist_cov
+                ),
             )
         )
         if d.publish_odom_tf:
-            self.tf.send_transform(_transform(ns, d.odometry_frame, d.robot_base_frame, x, y, yaw))
+            self.tf.send_transform(
+                mc.TransformStamped(
+                    mc.Header(mc.Time(sec, nsec), d.odometry_frame),
+                    d.robot_base_frame,
+                    mc.Transform(mc.Vector3(x, y, 0.0), mc.Quaternion(0.0, 0.0, qz, qw)),
+                )
+            )
         if self.joint_pub is not None:
+            # one buffer for position, velocity and effort (each message its own)
+            k = 2.0 / d.params.wheel_diameter_m
+            values = np.array([st[S_AL], st[S_AR], st[S_VL], st[S_VR], 0.0, 0.0])
+            values[2:4] *= k
             self.joint_pub.publish(
                 mc.JointState(
-                    _header(ns, ""),
+                    mc.Header(mc.Time(sec, nsec), ""),
                     [d.left_joint, d.right_joint],
-                    np.array([st[S_AL], st[S_AR]]),
-                    np.array([st[S_VL], st[S_VR]]) * (2.0 / d.params.wheel_diameter_m),
-                    np.zeros(2),
+                    values[0:2],
+                    values[2:4],
+                    values[4:6],
                 )
             )
 
@@ -402,21 +433,20 @@ class SimulatorNode(Node):
 
         ex = self._executor
         frame = sensor.frame_id
+        state = self._state  # updated in place, never replaced
+        measure = model.measure
+        publish = pub.publish
+        imu, header, stamp, quat, vec = mc.Imu, mc.Header, mc.Time, mc.Quaternion, mc.Vector3
 
         def tick() -> None:
-            self.advance()
-            st = self._state.tolist()
-            q, gyro, acc = model.measure(st[S_TH], st[S_V], st[S_W], st[S_DV])
-            pub.publish(
-                mc.Imu(
-                    _header(ex.now_ns, frame),
-                    mc.Quaternion(*q),
-                    cov,
-                    mc.Vector3(*gyro),
-                    cov,
-                    mc.Vector3(*acc),
-                    cov,
-                )
+            # runs at the physics rate: names bound once, the header built inline
+            if ex.now_ns >= self._physics_ns + self._step_ns:
+                self.advance()
+            st = state.tolist()
+            q, gyro, acc = measure(st[S_TH], st[S_V], st[S_W], st[S_DV])
+            sec, nsec = divmod(ex.now_ns, 1_000_000_000)
+            publish(
+                imu(header(stamp(sec, nsec), frame), quat(*q), cov, vec(*gyro), cov, vec(*acc), cov)
             )
 
         self.create_timer(1.0 / rate, tick)
@@ -448,7 +478,7 @@ class SimulatorNode(Node):
         def tick() -> None:
             ns = self.get_clock().now_ns()
             x, y, z, yaw, pitch = self.sensor_pose(sensor.mount)
-            rgb, _ = model.capture(self.scene, x, y, z, yaw, pitch)
+            rgb = model.capture_rgb(self.scene, x, y, z, yaw, pitch)
             image_pub.publish(_image(ns, sensor.frame_id, rgb, "rgb8"))
             info_pub.publish(self._camera_info(ns, sensor.frame_id, model))
 

@@ -8,14 +8,16 @@ plus (for the IMU) a constant bias drawn once per run from N(bias_mean, bias_std
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass
+from typing import Any
 
 import numba
 import numpy as np
 from numpy.typing import NDArray
 
 from roverlab.raycast import Scene
-from roverlab.raycast.camera import render
+from roverlab.raycast.camera import render, render_rgb
 from roverlab.raycast.lidar import cast_2d
 
 __all__ = ["CameraModel", "ImuModel", "ImuNoise", "LidarModel", "LidarParams"]
@@ -23,6 +25,8 @@ __all__ = ["CameraModel", "ImuModel", "ImuNoise", "LidarModel", "LidarParams"]
 F64 = NDArray[np.float64]
 GRAVITY = 9.80665
 _BLOCK = 1024
+_SCAN_BLOCK = 64
+_POOL_SIZE = 4  # camera images kept for reuse per camera
 
 
 @dataclass(frozen=True, slots=True)
@@ -73,16 +77,26 @@ class LidarModel:
         self.params = params
         self.rng = rng
         self._rel = params.angles()
+        # noise rows drawn _SCAN_BLOCK scans at a time: the same numbers, in the same
+        # order, as one draw per scan (the generator serves nobody else)
+        self._noise: F64 = np.full((1, params.samples), params.noise_mean)
+        self._row = 0 if params.noise_stddev <= 0 else 1
+
+    def _noise_row(self) -> F64:
+        p = self.params
+        if p.noise_stddev <= 0:
+            return self._noise[0]
+        if self._row >= self._noise.shape[0]:
+            self._noise = self.rng.normal(p.noise_mean, p.noise_stddev, (_SCAN_BLOCK, p.samples))
+            self._row = 0
+        row = self._noise[self._row]
+        self._row += 1
+        return row
 
     def scan(self, scene: Scene, x: float, y: float, z: float, yaw: float) -> NDArray[np.float32]:
         p = self.params
         ranges = cast_2d(scene, x, y, z, self._rel + yaw, p.range_max)
-        noise = (
-            self.rng.normal(p.noise_mean, p.noise_stddev, ranges.shape)
-            if p.noise_stddev > 0
-            else np.full(ranges.shape, p.noise_mean)
-        )
-        return _finish_scan(ranges, noise, p.range_min, p.range_max, p.range_resolution)
+        return _finish_scan(ranges, self._noise_row(), p.range_min, p.range_max, p.range_resolution)
 
 
 @numba.njit(cache=True, nogil=True)
@@ -213,31 +227,63 @@ class CameraParams:
             raise ValueError("camera clip must satisfy 0 < near < far")
 
 
+def _refcount(pool: list[NDArray[np.uint8]], i: int) -> int:
+    return sys.getrefcount(pool[i])
+
+
 class CameraModel:
     """RGB and depth images rendered from the 2.5-D scene, with Gazebo's pixel noise."""
 
     def __init__(self, params: CameraParams, rng: np.random.Generator) -> None:
         self.params = params
         self.rng = rng
+        self._pool: list[NDArray[np.uint8]] = []
+        self._free_refs = 0
 
     def capture(
         self, scene: Scene, x: float, y: float, z: float, yaw: float, pitch: float = 0.0
     ) -> tuple[NDArray[np.uint8], NDArray[np.float32]]:
+        rgb, depth = render(scene, x, y, z, yaw, pitch=pitch, **self._optics())
+        return self._noisy(rgb), depth
+
+    def capture_rgb(
+        self, scene: Scene, x: float, y: float, z: float, yaw: float, pitch: float = 0.0
+    ) -> NDArray[np.uint8]:
+        """:meth:`capture`'s RGB image alone (the same pixels and noise draws).
+
+        The image may be one this model returned before, rendered over again once
+        nothing else refers to it any more (a message holding it keeps it alive), which
+        saves the operating system handing out fresh pages for every frame.
+        """
+        out = self._free_buffer()
+        return self._noisy(render_rgb(scene, x, y, z, yaw, pitch=pitch, out=out, **self._optics()))
+
+    def _optics(self) -> dict[str, Any]:
         p = self.params
-        rgb, depth = render(
-            scene,
-            x,
-            y,
-            z,
-            yaw,
-            hfov=p.horizontal_fov,
-            width=p.width,
-            height=p.height,
-            near=p.clip_near,
-            far=p.clip_far,
-            pitch=pitch,
-        )
+        return {
+            "hfov": p.horizontal_fov,
+            "width": p.width,
+            "height": p.height,
+            "near": p.clip_near,
+            "far": p.clip_far,
+        }
+
+    def _free_buffer(self) -> NDArray[np.uint8] | None:
+        """An image of the pool nobody else refers to, a new pooled one, or None."""
+        pool = self._pool
+        for i in range(len(pool)):
+            if _refcount(pool, i) <= self._free_refs:
+                return pool[i]
+        if len(pool) >= _POOL_SIZE:
+            return None
+        pool.append(np.empty((self.params.height, self.params.width, 3), dtype=np.uint8))
+        # what a buffer nobody else holds counts, measured the way the loop above does
+        self._free_refs = _refcount(pool, len(pool) - 1)
+        return pool[-1]
+
+    def _noisy(self, rgb: NDArray[np.uint8]) -> NDArray[np.uint8]:
+        p = self.params
         if p.noise_stddev > 0 or p.noise_mean != 0:
             noise = self.rng.normal(p.noise_mean, p.noise_stddev, rgb.shape) * 255.0
-            rgb = np.clip(rgb.astype(np.float32) + noise, 0, 255).astype(np.uint8)
-        return rgb, depth
+            return np.clip(rgb.astype(np.float32) + noise, 0, 255).astype(np.uint8)
+        return rgb

@@ -68,6 +68,7 @@ from roverlab.slam.graph.matcher import (
     block_size,
     build_grid,
     match_scan,
+    response,
     valid_points,
 )
 from roverlab.slam.graph.params import GraphParams
@@ -82,6 +83,8 @@ OCCUPANCY_THRESHOLD = 0.1
 #: Largest number of solver iterations after a loop closure (warm-started).
 _OPT_ITERATIONS = 20
 _TWO_PI = 2.0 * math.pi
+#: Most re-centred searches when a sequential match lands on the rim of its angular window.
+_RIM_SEARCHES = 3
 
 
 @dataclass(frozen=True, eq=False)
@@ -264,6 +267,7 @@ class GraphSLAM:
         self.loop_closures = 0
         self.rejected_loop_closures = 0
         self.optimisations = 0
+        self.rim_searches = 0
         self.last_response = 0.0
 
     @property
@@ -388,6 +392,7 @@ class GraphSLAM:
             result: MatchResult | None = None
             if p.use_scan_matching and pts.shape[0] >= 3 and self._grid is not None:
                 result = self._match_sequential(self._grid, pts, pred, penalise=True, cov=keyframe)
+                result = self._beyond_the_rim(self._grid, pts, pred, result, keyframe)
                 pose = result.pose
                 self.last_response = result.response
             else:
@@ -448,6 +453,33 @@ class GraphSLAM:
             covariance=cov,
             response_expansion=p.use_response_expansion,
         )
+
+    def _beyond_the_rim(
+        self,
+        grid: CorrelationGrid,
+        pts: FloatArray,
+        pred: FloatArray,
+        result: MatchResult,
+        cov: bool,
+    ) -> MatchResult:
+        """A best match on the rim of the angular window is no optimum: the odometry's turn
+        was off by more than the window (a log whose odometry stalls for a few scans and
+        then catches up at once, as mit-csail's does while turning). Search again centred
+        on it, at most ``_RIM_SEARCHES`` times, while the unpenalised response improves."""
+        p = self.params
+        rim = p.coarse_search_angle_offset - p.coarse_angle_resolution
+        centre = pred
+        best = response(grid, pts, result.pose)
+        for _ in range(_RIM_SEARCHES):
+            if abs(_wrap(result.pose[2] - centre[2])) < rim:
+                break
+            again = self._match_sequential(grid, pts, result.pose, penalise=True, cov=cov)
+            score = response(grid, pts, again.pose)
+            if score <= best:
+                break
+            self.rim_searches += 1
+            centre, result, best = result.pose, again, score
+        return result
 
     def _laser_position(self, k: int) -> FloatArray:
         return _compose(self._kf_pose[k], self._kf_scans[k].laser_offset)[:2]
