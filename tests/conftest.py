@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import os
-import socket
 import subprocess
 import sys
 from collections.abc import Iterator
@@ -11,16 +10,11 @@ from pathlib import Path
 
 import pytest
 
+from tests.helpers.net import free_port
 from tests.helpers.procs import Proc
 
 HELPERS = Path(__file__).parent / "helpers"
 REPO = Path(__file__).resolve().parents[1]
-
-
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return int(s.getsockname()[1])
 
 
 @pytest.fixture(scope="session", autouse=True)
@@ -40,7 +34,7 @@ def daemon(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
     """A daemon on a free loopback port; ROVERLAB_DAEMON points every process at it."""
     from roverlab.core.transport.daemon import ensure_daemon, stop_daemon
 
-    endpoint = f"tcp/127.0.0.1:{_free_port()}"
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
     old = os.environ.get("ROVERLAB_DAEMON")
     os.environ["ROVERLAB_DAEMON"] = endpoint
     os.environ["ROVERLAB_LOG_DIR"] = str(tmp_path_factory.mktemp("log"))

@@ -17,17 +17,9 @@ from roverlab.core.transport.zenoh import (
     query_parameters,
 )
 from roverlab.msgs import String
+from tests.helpers.net import free_port, wait_until
 
 pytestmark = pytest.mark.zenoh
-
-
-def _wait(pred: Any, timeout: float = 10.0) -> bool:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if pred():
-            return True
-        time.sleep(0.02)
-    return bool(pred())
 
 
 def test_messages_cross_processes(node_proc: Any) -> None:
@@ -40,7 +32,7 @@ def test_messages_cross_processes(node_proc: Any) -> None:
     connect_context(ctx)
     ctx.spin_in_thread()
     try:
-        assert _wait(lambda: len(got) >= 10)
+        assert wait_until(lambda: len(got) >= 10)
     finally:
         ctx.shutdown()
     numbers = [int(s.rsplit(" ", 1)[1]) for s in got]
@@ -58,10 +50,10 @@ def test_round_trip_and_graph(node_proc: Any) -> None:
     transport = connect_context(ctx)
     ctx.spin_in_thread()
     try:
-        assert _wait(lambda: pub.topic.remote_send is not None)
+        assert wait_until(lambda: pub.topic.remote_send is not None)
         for i in range(20):
             pub.publish(String(data=f"p{i}"))
-        assert _wait(lambda: len(got) == 20)
+        assert wait_until(lambda: len(got) == 20)
         assert got == [f"p{i}" for i in range(20)]
         ents = [e for e in query_graph(transport.session) if e.zid != transport.zid]
         assert any(e.kind == "node" and e.node == "/proc_pong" for e in ents)
@@ -92,7 +84,7 @@ def test_clock_crosses_processes(node_proc: Any) -> None:
     connect_context(ctx)
     ctx.spin_in_thread()
     try:
-        assert _wait(lambda: len(fired) >= 5)
+        assert wait_until(lambda: len(fired) >= 5)
     finally:
         ctx.shutdown()
     assert ctx.now().nanoseconds > 0
@@ -111,18 +103,13 @@ def test_latched_topic_reaches_late_remote_subscriber(node_proc: Any) -> None:
     connect_context(ctx)
     ctx.spin_in_thread()
     try:
-        assert _wait(lambda: got == ["the map"], timeout=5)
+        assert wait_until(lambda: got == ["the map"], timeout=5)
     finally:
         ctx.shutdown()
 
 
 def test_user_password_auth_and_explicit_endpoints() -> None:
-    import socket
-
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        port = s.getsockname()[1]
-    ep = f"tcp/127.0.0.1:{port}"
+    ep = f"tcp/127.0.0.1:{free_port()}"
     server_ctx = Context(clock="wall")
     pub = server_ctx.create_node("robot").create_publisher(String, "/secret", 10)
     server_ctx.add_transport(
@@ -147,11 +134,11 @@ def test_user_password_auth_and_explicit_endpoints() -> None:
     for c in (server_ctx, good_ctx, bad_ctx):
         c.spin_in_thread()
     try:
-        assert _wait(lambda: pub.topic.remote_send is not None, timeout=5)
+        assert wait_until(lambda: pub.topic.remote_send is not None, timeout=5)
         for _ in range(5):
             pub.publish(String(data="ok"))
             time.sleep(0.05)
-        assert _wait(lambda: len(good) >= 3, timeout=5)
+        assert wait_until(lambda: len(good) >= 3, timeout=5)
         assert bad == []
     finally:
         for c in (server_ctx, good_ctx, bad_ctx):
@@ -205,7 +192,7 @@ def test_a_second_clock_source_is_warned_about(
         connect_context(ctx)
         ctx.spin_in_thread()
         try:
-            assert _wait(lambda: "a second /clock source" in caplog.text, timeout=10)
+            assert wait_until(lambda: "a second /clock source" in caplog.text, timeout=10)
         finally:
             ctx.shutdown()
     assert "/proc_clock" in caplog.text or "/clock_publisher" in caplog.text

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import datetime
 import ipaddress
-import socket
 import time
 from pathlib import Path
 from typing import Any
@@ -19,6 +18,7 @@ from cryptography.x509.oid import NameOID
 from roverlab.core import Context
 from roverlab.core.transport.zenoh import TransportError, ZenohOptions, ZenohTransport
 from roverlab.msgs import String
+from tests.helpers.net import free_port, wait_until
 
 pytestmark = pytest.mark.zenoh
 
@@ -97,26 +97,11 @@ def _make_server_cert(directory: Path, ca_key: Any, ca_cert: x509.Certificate) -
     return cert_path, key_path
 
 
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return int(s.getsockname()[1])
-
-
-def _wait(pred: Any, timeout: float) -> bool:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if pred():
-            return True
-        time.sleep(0.02)
-    return bool(pred())
-
-
 def test_tls_with_a_self_signed_ca(tmp_path: Path) -> None:
     ca_path, ca_key, ca_cert = _make_ca(tmp_path, "lab-ca")
     other_ca, _, _ = _make_ca(tmp_path, "other-ca")
     cert, key = _make_server_cert(tmp_path, ca_key, ca_cert)
-    ep = f"tls/127.0.0.1:{_free_port()}"
+    ep = f"tls/127.0.0.1:{free_port()}"
 
     robot = Context(clock="wall")
     pub = robot.create_node("robot").create_publisher(String, "/chatter", 10)
@@ -140,7 +125,7 @@ def test_tls_with_a_self_signed_ca(tmp_path: Path) -> None:
     for c in (robot, laptop):
         c.spin_in_thread()
     try:
-        assert _wait(lambda: pub.topic.remote_send is not None, timeout=10)
+        assert wait_until(lambda: pub.topic.remote_send is not None, timeout=10)
         deadline = time.monotonic() + 10
         while len(got) < 3 and time.monotonic() < deadline:
             pub.publish(String(data="over tls"))
