@@ -174,6 +174,8 @@ class SimulatorNode(Node):
             ]
         )
         self._dt = self._step_ns / 1e9
+        obs = self.obstacles
+        self._near = np.zeros(len(obs.segments) + len(obs.circles), dtype=np.int64)
         self._advance = compiled_entry(
             advance,
             self._state,
@@ -185,6 +187,7 @@ class SimulatorNode(Node):
             self.obstacles.circles,
             self._noise,
             0,
+            self._near,
         )
         self.tf = TransformBroadcaster(self)
         self._mounts: dict[int, tuple[float, float, float, float, float]] = {}
@@ -268,6 +271,7 @@ class SimulatorNode(Node):
                 self.obstacles.circles,
                 self._noise,
                 self._noise_pos,
+                self._near,
             )
             steps -= chunk
             if steps > 0:
