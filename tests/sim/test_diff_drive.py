@@ -55,7 +55,7 @@ def _run(
 ) -> int:
     n = np.zeros((steps + 1, 2)) if noise is None else noise
     near = np.zeros(len(walls) + len(circles), dtype=np.int64)
-    return advance(st, params, steps, dt, FOOTPRINT, walls, circles, n, 0, near)
+    return advance(st, params, dt, FOOTPRINT, walls, circles, near, n, 0, steps)
 
 
 def test_wheel_acceleration_limits_ramp() -> None:

@@ -12,6 +12,7 @@ from roverlab.raycast.scene import Scene
 
 __all__ = [
     "Obstacles",
+    "any_near",
     "circle_polygon",
     "gather_near",
     "inner_radius",
@@ -164,6 +165,31 @@ def polygon_hits_near(
     for j in range(n_segments, n_segments + n_circles):
         c = circles[near[j]]
         if _touches_circle(poly, box, c[0], c[1], c[2]):
+            return True
+    return False
+
+
+@numba.njit(cache=True, nogil=True)
+def any_near(
+    x: float,
+    y: float,
+    radius: float,
+    segments: np.ndarray,
+    circles: np.ndarray,
+    near: np.ndarray,
+    n_segments: int,
+    n_circles: int,
+) -> bool:
+    """Whether any of the candidates (as :func:`polygon_hits_near`) comes within
+    ``radius`` of ``(x, y)``: when none does, a body inside that disc touches nothing."""
+    r2 = radius * radius
+    for j in range(n_segments):
+        s = segments[near[j]]
+        if _point_segment_dist2(x, y, s[0], s[1], s[2], s[3]) <= r2:
+            return True
+    for j in range(n_segments, n_segments + n_circles):
+        c = circles[near[j]]
+        if math.hypot(c[0] - x, c[1] - y) - c[2] <= radius:
             return True
     return False
 

@@ -25,7 +25,7 @@ from typing import Any, TypeVar
 import numba
 import numpy as np
 
-from roverlab.sim.collision import gather_near, polygon_hits_near
+from roverlab.sim.collision import any_near, gather_near, polygon_hits_near
 
 F = TypeVar("F", bound=Callable[..., Any])
 
@@ -39,8 +39,8 @@ S_V, S_W, S_DV = 12, 13, 14
 S_CONTACT = 15
 S_CONTACTS = 16
 # broad phase: the obstacles near an anchor point (indices in the ``near`` work array)
-S_AX, S_AY, S_AREACH, S_NSEG, S_NCIRC = 17, 18, 19, 20, 21
-STATE_SIZE = 22
+S_AX, S_AY, S_AREACH, S_NSEG, S_NCIRC, S_RADIUS = 17, 18, 19, 20, 21, 22
+STATE_SIZE = 23
 
 BROAD_MARGIN_M = 0.25  # how far the body may move from its anchor before a new gather
 
@@ -88,11 +88,15 @@ def _hits(
     near: np.ndarray,
     state: np.ndarray,
 ) -> bool:
+    ns, nc = int(state[S_NSEG]), int(state[S_NCIRC])
+    # nothing within the footprint's circumscribed circle (rounding margin): no contact
+    if not any_near(x, y, state[S_RADIUS] + 1e-9, segs, circles, near, ns, nc):
+        return False
     c, s = math.cos(th), math.sin(th)
     for i in range(fp.shape[0]):
         buf[i, 0] = x + c * fp[i, 0] - s * fp[i, 1]
         buf[i, 1] = y + s * fp[i, 0] + c * fp[i, 1]
-    return polygon_hits_near(buf, segs, circles, near, int(state[S_NSEG]), int(state[S_NCIRC]))
+    return polygon_hits_near(buf, segs, circles, near, ns, nc)
 
 
 @numba.njit(cache=True, nogil=True)
@@ -123,8 +127,9 @@ def _cover(
     ):
         return
     reach = max(BROAD_MARGIN_M, 2.0 * travel)
-    ns, nc = gather_near(x, y, _circumradius(fp) + reach + 1e-9, segs, circles, near)
-    state[S_AX], state[S_AY], state[S_AREACH] = x, y, reach
+    radius = _circumradius(fp)
+    ns, nc = gather_near(x, y, radius + reach + 1e-9, segs, circles, near)
+    state[S_AX], state[S_AY], state[S_AREACH], state[S_RADIUS] = x, y, reach, radius
     state[S_NSEG], state[S_NCIRC] = ns, nc
 
 
@@ -132,14 +137,14 @@ def _cover(
 def advance(
     state: np.ndarray,
     params: np.ndarray,
-    steps: int,
     dt: float,
     footprint: np.ndarray,
     segments: np.ndarray,
     circles: np.ndarray,
+    near: np.ndarray,
     noise: np.ndarray,
     noise_pos: int,
-    near: np.ndarray,
+    steps: int,
 ) -> int:
     """Run ``steps`` physics steps of ``dt`` on ``state`` in place.
 
