@@ -208,7 +208,8 @@ class RobotStatePublisher(Node):
                 updated[mimic.name] = mimic
         for name in names:
             self._last_published[name] = stamp_ns
-        if updated:
+        # transforms are built only when someone reads /tf (here or in another process)
+        if updated and self._tf.publisher.has_listeners:
             sec, nanosec = divmod(stamp_ns, 1_000_000_000)
             revolute, known = self._revolute, self._positions
             position_of = self.model.joint_position

@@ -340,7 +340,8 @@ class SimulatorNode(Node):
                 ),
             )
         )
-        if d.publish_odom_tf:
+        # the transform is built only when someone reads /tf (here or in another process)
+        if d.publish_odom_tf and self._tf_pub.has_listeners:
             self._tf_pub.publish(
                 mc.TFMessage(
                     [
