@@ -441,14 +441,23 @@ class SimulatorNode(Node):
         state = self._state  # updated in place, never replaced
         rows = model.noise_rows()
         advance, nxt, sin, cos = self.advance, next, math.sin, math.cos
+        physics, physics_args, slip_block = self._advance, self._physics_args, self._slip_block
+        driven = self.drive is not None
         publish = pub.publish
         imu, header, stamp, quat, vec = mc.Imu, mc.Header, mc.Time, mc.Quaternion, mc.Vector3
 
+        step_ns = self._step_ns
+
         def tick() -> None:
-            # runs at the physics rate: ImuModel.measure inlined, names bound once
+            # runs at the physics rate: ImuModel.measure and the usual one-step advance()
+            # inlined, names bound once
             now = ex.now_ns
-            if now >= self._physics_ns + self._step_ns:
-                advance()
+            if now >= self._physics_ns + step_ns:
+                if driven and now < self._physics_ns + 2 * step_ns and self._noise_pos < slip_block:
+                    self._physics_ns += step_ns
+                    self._noise_pos = physics(*physics_args, self._noise, self._noise_pos, 1)
+                else:
+                    advance()
             st = state.tolist()
             v, w = st[S_V], st[S_W]
             n = nxt(rows)
