@@ -32,9 +32,7 @@ from typing import Final
 
 from roverlab.description.errors import URDFError
 from roverlab.description.gazebo_specs import (
-    GAZEBO_MATERIALS,
     NOISE_TYPES,
-    SENSOR_TYPES,
     CameraPluginSpec,
     CameraSpec,
     DiffDriveSpec,
@@ -50,36 +48,12 @@ from roverlab.description.gazebo_specs import (
     PluginSpec,
     RaySpec,
     ScanAxis,
-    gazebo_material_rgba,
     resolve_frame,
     resolve_topic,
 )
 from roverlab.geometry import Transform3, quat_from_rpy
 
-__all__ = [
-    "GAZEBO_MATERIALS",
-    "PLUGIN_SPECS",
-    "SENSOR_TYPES",
-    "CameraPluginSpec",
-    "CameraSpec",
-    "DiffDriveSpec",
-    "GazeboExtensions",
-    "GazeboPlugin",
-    "GazeboReference",
-    "GazeboSensor",
-    "ImuPluginSpec",
-    "ImuSpec",
-    "KinectPluginSpec",
-    "LaserPluginSpec",
-    "NoiseSpec",
-    "PluginSpec",
-    "RaySpec",
-    "ScanAxis",
-    "gazebo_material_rgba",
-    "parse_gazebo",
-    "resolve_frame",
-    "resolve_topic",
-]
+__all__ = ["PLUGIN_SPECS", "parse_gazebo"]
 
 
 # --------------------------------------------------------------------------- parsing

@@ -54,27 +54,6 @@ from roverlab.maps.errors import MapError
 from roverlab.msgs import array_to_occupancy_grid, occupancy_grid_to_array
 from roverlab.msgs import classes as mc
 
-__all__ = [
-    "CellCounts",
-    "ImageFormat",
-    "MapInfo",
-    "MapMode",
-    "OccupancyMap",
-    "SavedMap",
-    "cell_counts",
-    "check_save_thresholds",
-    "format_map_yaml",
-    "image_to_occupancy",
-    "load_map",
-    "occupancy_to_image",
-    "pgm_bytes",
-    "read_image_pixels",
-    "read_map_yaml",
-    "save_map",
-    "save_occupancy_grid",
-    "yaw_of_quaternion",
-]
-
 ImageFormat = Literal["pgm", "png"]
 
 #: Pixel values map_saver writes.

@@ -36,23 +36,6 @@ from typing import Final, Protocol
 
 from roverlab.teleop.errors import TeleopError
 
-__all__ = [
-    "CTRL_C",
-    "HELP_TEXT",
-    "MOVE_BINDINGS",
-    "SMOOTH_HELP_TEXT",
-    "SMOOTH_MOVE_BINDINGS",
-    "SPEED_BINDINGS",
-    "KeyResult",
-    "SmoothTeleop",
-    "TeleopLogic",
-    "TeleopTwistKeyboard",
-    "TwistCommand",
-    "check_speed",
-    "twist_for_key",
-    "vels",
-]
-
 CTRL_C: Final = "\x03"
 
 HELP_TEXT: Final = """
