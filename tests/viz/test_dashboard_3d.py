@@ -34,24 +34,14 @@ from roverlab.tf import StaticTransformBroadcaster
 from roverlab.tf.convert import transform_to_msg
 from roverlab.viz import DashboardServer
 from roverlab.viz.config import DisplayConfig, load_rviz
+from tests.helpers.browser import CHROMIUM
 
-CHROMIUM = Path("/usr/bin/chromium")
-CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--no-first-run"]
 VIEWPORT = {"width": 1400, "height": 860}
 MYCAR = Path(roverlab.packages.__file__).parent / "mycar"
 URDLEE = Path(__file__).parent / "fixtures" / "urdlee"
 
 playwright_sync = pytest.importorskip("playwright.sync_api", reason="playwright not installed")
 pytestmark = pytest.mark.skipif(not CHROMIUM.exists(), reason="/usr/bin/chromium is absent")
-
-
-@pytest.fixture(scope="module")
-def browser() -> Iterator[Any]:
-    pw = playwright_sync.sync_playwright().start()
-    b = pw.chromium.launch(executable_path=str(CHROMIUM), args=CHROMIUM_ARGS)
-    yield b
-    b.close()
-    pw.stop()
 
 
 def _open(browser: Any, server: DashboardServer, ready: str, timeout_ms: int = 60000) -> Any:

@@ -121,8 +121,24 @@ class CellCounts(NamedTuple):
     other: int
 
 
+class GridShape:
+    """``width`` and ``height`` (cells) of a class whose ``data`` is a ``(height, width)``
+    array, row 0 at the origin (``OccupancyGrid`` order)."""
+
+    __slots__ = ()
+    data: NDArray[Any]
+
+    @property
+    def width(self) -> int:
+        return int(self.data.shape[1])
+
+    @property
+    def height(self) -> int:
+        return int(self.data.shape[0])
+
+
 @dataclass(frozen=True, slots=True)
-class OccupancyMap:
+class OccupancyMap(GridShape):
     """A loaded map: its settings and its cells.
 
     Attributes:
@@ -132,14 +148,6 @@ class OccupancyMap:
 
     info: MapInfo
     data: NDArray[np.int8]
-
-    @property
-    def width(self) -> int:
-        return int(self.data.shape[1])
-
-    @property
-    def height(self) -> int:
-        return int(self.data.shape[0])
 
     def counts(self) -> CellCounts:
         return cell_counts(self.data)
