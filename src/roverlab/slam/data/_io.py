@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-import contextlib
 import math
-import os
-import tempfile
 from collections.abc import Iterator, Sequence
 from pathlib import Path
+
+from roverlab import fileio
 
 __all__ = ["atomic_write_text", "finite_floats", "text_rows"]
 
@@ -45,25 +44,14 @@ def finite_floats(parts: Sequence[str], where: str, error: type[Exception]) -> l
 
 
 def atomic_write_text(path: str | Path, text: str, error: type[Exception]) -> None:
-    """Write ``text`` (UTF-8, ``\\n`` line ends) to ``path`` through a temporary file.
-
-    The temporary file lives in the same directory and is renamed over ``path`` once
-    complete, so a reader never sees a half-written file.
+    """Write ``text`` (UTF-8, ``\\n`` line ends) to ``path`` through a temporary file
+    (:func:`roverlab.fileio.atomic_write_text`), so a reader never sees a half-written file.
 
     Raises:
         error: the file cannot be written (the message names it).
     """
     p = Path(path)
-    tmp: str | None = None
     try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".tmp", dir=p.parent)
-        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as fh:
-            fh.write(text)
-        os.replace(tmp, p)
-        tmp = None
+        fileio.atomic_write_text(p, text)
     except OSError as err:
         raise error(f"{p}: cannot write: {err.strerror or err}") from err
-    finally:
-        if tmp is not None:
-            with contextlib.suppress(OSError):
-                os.unlink(tmp)
