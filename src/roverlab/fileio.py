@@ -1,7 +1,9 @@
 """Atomic file writes: a reader never sees a half-written file.
 
 The data goes to a temporary file in the target's folder, which is renamed over the target
-once complete; on any error the temporary file is removed and the target is untouched.
+once complete; on any error the temporary file is removed and the target is untouched. The
+file gets the permissions a plain ``open(path, "w")`` would give it (the process's umask
+applied to 0o666, or the mode of the file it replaces), not the temporary file's 0o600.
 """
 
 from __future__ import annotations
@@ -16,6 +18,23 @@ from typing import BinaryIO
 __all__ = ["atomic_write", "atomic_write_bytes", "atomic_write_text"]
 
 
+def _umask() -> int:
+    """The process's umask, read without changing it (``os.umask`` sets it process-wide,
+    racing other threads that create files); 0o022 where /proc does not say."""
+    with contextlib.suppress(OSError, ValueError), open("/proc/self/status") as f:
+        for line in f:
+            if line.startswith("Umask:"):
+                return int(line.split()[1], 8)
+    return 0o022
+
+
+def _mode_for(path: Path) -> int:
+    try:
+        return path.stat().st_mode & 0o7777
+    except OSError:
+        return 0o666 & ~_umask()
+
+
 def atomic_write(path: str | os.PathLike[str], write: Callable[[BinaryIO], object]) -> None:
     """Call ``write`` with a binary file that becomes ``path`` once ``write`` returns.
 
@@ -28,6 +47,7 @@ def atomic_write(path: str | os.PathLike[str], write: Callable[[BinaryIO], objec
     try:
         with os.fdopen(fd, "wb") as fh:
             write(fh)
+        os.chmod(tmp, _mode_for(p))
         os.replace(tmp, p)
     except BaseException:
         with contextlib.suppress(OSError):
