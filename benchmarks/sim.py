@@ -10,6 +10,9 @@ clock as fast as the CPU allows. Prints, one figure per line, after the machine 
    out of the robot's sensor config), an in-process subscriber counting /scan, /imu and
    /odom so every message is built and delivered; 2 s of warm-up (numba compile) are not
    timed (target >= 1000x);
+   Then the same with a subscriber on /tf as well: the simulator's odometry transform
+   and robot_state_publisher's wheel transforms are built only while someone reads
+   /tf (in this process or another), so case 1 does not build them;
 2. the same with mybot's 640x480 camera at 30 Hz and a subscriber on /image_raw too
    (target >= 50x);
 3. lidar rays/s: ``cast_2d`` timed alone in a tight loop over the scan poses of run 1,
@@ -92,8 +95,10 @@ class RoverlabRun:
     scan_poses: list[tuple[float, float, float, float]]
 
 
-def build_roverlab(world: World, *, cameras: bool) -> RoverlabRun:
-    """The simulation ``roverlab sim`` runs, with the cameras optional."""
+def build_roverlab(world: World, *, cameras: bool, tf_reader: bool = False) -> RoverlabRun:
+    """The simulation ``roverlab sim`` runs, with the cameras optional; ``tf_reader`` adds
+    a subscriber on /tf (the odometry and wheel transforms are built only when someone
+    reads them)."""
     ctx = Context()
     sim = Simulation(context=ctx, world=world, robot=ROBOT, cameras=cameras)
     simulator, config = sim.simulator, sim.config
@@ -120,6 +125,9 @@ def build_roverlab(world: World, *, cameras: bool) -> RoverlabRun:
     node.create_subscription("nav_msgs/msg/Odometry", "/odom", counter("/odom"), 100)
     if cameras:
         node.create_subscription("sensor_msgs/msg/Image", "/image_raw", counter("/image_raw"), 10)
+    if tf_reader:
+        counts["/tf"] = 0
+        node.create_subscription("tf2_msgs/msg/TFMessage", "/tf", counter("/tf"), 100)
     pub = node.create_publisher(Twist, "/cmd_vel", 10)
     cmd = Twist(linear_x=CMD_V, angular_z=CMD_W)
     node.create_timer(CMD_PERIOD_S, lambda: pub.publish(cmd))
@@ -130,7 +138,12 @@ CHUNK_S = 10.0  # sim seconds per timed slice
 
 
 def time_roverlab(
-    world: World, seconds: float, *, cameras: bool, profile: cProfile.Profile | None = None
+    world: World,
+    seconds: float,
+    *,
+    cameras: bool,
+    tf_reader: bool = False,
+    profile: cProfile.Profile | None = None,
 ) -> tuple[float, float, float, RoverlabRun]:
     """Real-time factors over ``seconds`` after warm-up, timed in slices of ``CHUNK_S``.
 
@@ -138,7 +151,7 @@ def time_roverlab(
     a VM whose host lends it CPU unevenly (steal time): the same code runs 1.6x slower
     in some minutes, so the median of slices and the best slice say more than one total.
     """
-    run = build_roverlab(world, cameras=cameras)
+    run = build_roverlab(world, cameras=cameras, tf_reader=tf_reader)
     run.context.spin_for(WARMUP_S)
     for k in run.counts:
         run.counts[k] = 0
@@ -347,6 +360,15 @@ def main() -> None:
         f"{CHUNK_S:g} s slices (target >= 1000x; per CPU second {cpu_lidar:.0f}x); "
         f"received {fmt_counts(run1.counts, seconds)}; "
         f"{path_note(run1.scan_poses)}",
+        flush=True,
+    )
+    # 1b. the same with a /tf reader (nobody reads /tf in case 1, so no transform is built)
+    tf_s = seconds / 2
+    rtf_tf, best_tf, cpu_tf, run1b = time_roverlab(world, tf_s, cameras=False, tf_reader=True)
+    print(
+        f"roverlab RTF, case 1 with a /tf subscriber too, {tf_s:g} sim s: median "
+        f"{rtf_tf:.0f}x, best {best_tf:.0f}x (per CPU second {cpu_tf:.0f}x); "
+        f"received {fmt_counts(run1b.counts, tf_s)}",
         flush=True,
     )
 

@@ -16,7 +16,7 @@ SRC = Path(roverlab.__file__).resolve().parent
 #: long as that makes no cycle). The algorithms under localization/, navigation/,
 #: perception/ and slam/ know nothing of launch files, the dashboard or the command line.
 LAYERS: list[tuple[str, ...]] = [
-    ("errors", "geometry", "raycast", "charts", "packages"),
+    ("errors", "fileio", "geometry", "raycast", "charts", "packages"),
     ("msgs",),
     ("core", "world"),
     ("tf", "actionlib", "batch"),

@@ -15,8 +15,9 @@ from PIL import Image
 from rosbags.highlevel import AnyReader
 
 from roverlab.maps import load_map
+from tests.helpers.browser import CHROMIUM, CHROMIUM_ARGS
 from tests.helpers.procs import Proc
-from tests.viz.test_dashboard import CHROMIUM, CHROMIUM_ARGS, VIEWPORT
+from tests.viz.test_dashboard import VIEWPORT
 
 DEMO = [sys.executable, "-m", "roverlab.cli", "demo", "--no-expose"]
 

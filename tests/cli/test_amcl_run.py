@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 
 from roverlab.cli.amcl_run import start_pose
-from roverlab.cli.main import main
 from roverlab.geometry import SE2
 from roverlab.maps import save_map
 from roverlab.slam.data.trajectory import Trajectory, write_tum
+from tests.helpers.nodes import run_main
 
 DATA = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "radish"
 INTEL = DATA / "intel.clf.bz2"
@@ -23,15 +23,6 @@ INTEL = DATA / "intel.clf.bz2"
 def _cli(*args: str) -> subprocess.CompletedProcess[str]:
     return subprocess.run([sys.executable, "-m", "roverlab.cli", *args], capture_output=True,
                           text=True, timeout=300)  # fmt: skip
-
-
-def _main(argv: list[str]) -> int:
-    """The ``roverlab`` entry point in this process: its exit code."""
-    try:
-        main(argv)
-    except SystemExit as done:
-        return int(done.code or 0)
-    return 0
 
 
 @pytest.mark.skipif(not INTEL.is_file(), reason="shared/data/radish is absent")
@@ -90,7 +81,7 @@ def test_start_pose_rule(tmp_path: Path) -> None:
 def test_bad_input_is_one_line_exit_2(
     tmp_path: Path, args: list[str], message: str, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    assert _main(["amcl", "run", str(tmp_path / "x.clf"), "--map", str(_free_map(tmp_path)),
+    assert run_main(["amcl", "run", str(tmp_path / "x.clf"), "--map", str(_free_map(tmp_path)),
                   *args]) == 2  # fmt: skip
     assert capsys.readouterr().err.strip() == message
 
@@ -99,7 +90,7 @@ def test_a_map_without_free_cells_names_the_file(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     yaml_path = _free_map(tmp_path, np.full((10, 10), 100, dtype=np.int8))
-    assert _main(["amcl", "run", str(tmp_path / "x.clf"), "--map", str(yaml_path)]) == 2
+    assert run_main(["amcl", "run", str(tmp_path / "x.clf"), "--map", str(yaml_path)]) == 2
     assert capsys.readouterr().err.strip() == (
         f"error: {yaml_path}: the map (10 x 10 cells) has no free cell (value 0): amcl has "
         "nowhere to put a particle"

@@ -11,7 +11,7 @@ import yaml
 
 from roverlab.description import load_robot
 from roverlab.sim.app import resolve_robot
-from tests.helpers.procs import Proc
+from tests.helpers.procs import Proc, twist_pub_args
 
 pytestmark = pytest.mark.zenoh
 
@@ -32,13 +32,7 @@ def test_seed_habit_pub_rate_and_echo_once_find_each_other(cli: Any) -> None:
             sys.executable,
             "-m",
             "roverlab.cli",
-            "topic",
-            "pub",
-            "-r",
-            "10",
-            "/cmd_vel",
-            "geometry_msgs/Twist",
-            "{linear: {x: 0.2}, angular: {z: 0.5}}",
+            *twist_pub_args(0.2, 0.5),
         ]
     )
     try:

@@ -24,6 +24,8 @@ from pathlib import Path
 import pytest
 import yaml
 
+from tests.helpers.procs import twist_pub_args
+
 pytestmark = pytest.mark.timeout(360)
 
 ROVERLAB = str(Path(sys.executable).with_name("roverlab"))
@@ -225,13 +227,7 @@ def test_robot_and_laptop_over_a_veth_pair(namespaces: Namespaces, tmp_path: Pat
             ROVERLAB,
             *connect,
             *AUTH,
-            "topic",
-            "pub",
-            "-r",
-            "10",
-            "/cmd_vel",
-            "geometry_msgs/Twist",
-            "{linear: {x: 0.0}, angular: {z: 0.5}}",
+            *twist_pub_args(0.0, 0.5),
         ],
         laptop_env,
     )

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import logging
 import math
-from collections.abc import Iterator
 
 import numpy as np
 import pytest
@@ -136,15 +135,6 @@ def lidar() -> RplidarEmulator:
     dev.start()
     yield dev
     dev.close()
-
-
-@pytest.fixture
-def contexts() -> Iterator[list[Context]]:
-    """Contexts shut down after the test, passed or not (their reader threads stop)."""
-    made: list[Context] = []
-    yield made
-    for ctx in made:
-        ctx.shutdown()
 
 
 def start_node(

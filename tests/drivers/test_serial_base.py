@@ -65,15 +65,6 @@ def test_controller_ramp_and_timeout() -> None:
         BaseParams(wheel_diameter=0.1, wheel_track=0.0, encoder_resolution=10)
 
 
-@pytest.fixture
-def contexts() -> Iterator[list[Context]]:
-    """Contexts shut down after the test, passed or not (their poll threads stop)."""
-    made: list[Context] = []
-    yield made
-    for ctx in made:
-        ctx.shutdown()
-
-
 def run_base(
     contexts: list[Context], port: str, **extra: object
 ) -> tuple[Context, ArduinoBaseNode, list[mc.Odometry]]:

@@ -12,10 +12,10 @@ from __future__ import annotations
 import sys
 from typing import Any
 
+from child_main import echo_cmd_vel, serve_ready
+
 from roverlab.actionlib import SimpleActionServer
 from roverlab.core import Context
-from roverlab.core.transport.daemon import connect_context
-from roverlab.msgs import Twist
 
 
 def main(behaviour: str, rate: float) -> None:
@@ -50,18 +50,8 @@ def main(behaviour: str, rate: float) -> None:
     server.register_preempt_callback(on_preempt)
     node.create_timer(0.5, step)
 
-    def on_cmd(msg: Any) -> None:
-        print(f"cmd_vel {msg.linear.x:.3f} {msg.angular.z:.3f}", flush=True)
-
-    node.create_subscription(Twist, "/cmd_vel", on_cmd, 10)
-    connect_context(ctx)
-    print("READY", flush=True)
-    try:
-        ctx.spin()
-    except KeyboardInterrupt:
-        pass
-    finally:
-        ctx.shutdown()
+    echo_cmd_vel(node)
+    serve_ready(ctx)
 
 
 if __name__ == "__main__":

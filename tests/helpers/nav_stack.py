@@ -8,8 +8,9 @@ from __future__ import annotations
 import os
 import sys
 
+from child_main import serve_ready
+
 from roverlab.core import Context
-from roverlab.core.transport.daemon import connect_context
 from roverlab.description import find_package
 from roverlab.launch import build_launch
 
@@ -25,14 +26,7 @@ def main(rate: float, planner: str) -> None:
         {"simulation": "true", "planner": planner},
         context=ctx,
     )
-    connect_context(ctx)
-    print("READY", flush=True)
-    try:
-        ctx.spin()
-    except KeyboardInterrupt:
-        pass
-    finally:
-        ctx.shutdown()
+    serve_ready(ctx)
 
 
 if __name__ == "__main__":

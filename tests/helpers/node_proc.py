@@ -12,10 +12,11 @@ from __future__ import annotations
 import sys
 from typing import Any
 
+from child_main import echo_cmd_vel, serve_ready
+
 from roverlab.actionlib import SimpleActionServer
 from roverlab.core import Context, QoSProfile
-from roverlab.core.transport.daemon import connect_context
-from roverlab.msgs import String, Twist
+from roverlab.msgs import String
 
 
 def _fibonacci_server(node: Any) -> None:
@@ -79,19 +80,8 @@ def main(mode: str) -> None:
     elif mode == "fibonacci":
         _fibonacci_server(node)
     elif mode == "listener":
-
-        def show(m: object) -> None:
-            print(f"cmd_vel {m.linear.x:.3f} {m.angular.z:.3f}", flush=True)  # type: ignore[attr-defined]
-
-        node.create_subscription(Twist, "/cmd_vel", show, 10)
-    connect_context(ctx)
-    print("READY", flush=True)
-    try:
-        ctx.spin()
-    except KeyboardInterrupt:
-        pass
-    finally:
-        ctx.shutdown()
+        echo_cmd_vel(node)
+    serve_ready(ctx)
 
 
 if __name__ == "__main__":

@@ -9,7 +9,13 @@ import threading
 import time
 from collections.abc import Callable
 
-__all__ = ["Proc"]
+__all__ = ["Proc", "twist_pub_args"]
+
+
+def twist_pub_args(linear_x: float, angular_z: float) -> list[str]:
+    """``roverlab`` arguments that publish a ``geometry_msgs/Twist`` on /cmd_vel at 10 Hz."""
+    twist = f"{{linear: {{x: {linear_x}}}, angular: {{z: {angular_z}}}}}"
+    return ["topic", "pub", "-r", "10", "/cmd_vel", "geometry_msgs/Twist", twist]
 
 
 class Proc:

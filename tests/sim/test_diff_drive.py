@@ -54,7 +54,8 @@ def _run(
     noise: np.ndarray | None = None,
 ) -> int:
     n = np.zeros((steps + 1, 2)) if noise is None else noise
-    return advance(st, params, steps, dt, FOOTPRINT, walls, circles, n, 0)
+    near = np.zeros(len(walls) + len(circles), dtype=np.int64)
+    return advance(st, params, dt, FOOTPRINT, walls, circles, near, n, 0, steps)
 
 
 def test_wheel_acceleration_limits_ramp() -> None:

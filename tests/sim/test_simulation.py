@@ -100,6 +100,32 @@ def test_world_odometry_equals_ground_truth_and_tf() -> None:
     assert math.hypot(last.pose.pose.position.x + 1, last.pose.pose.position.y + 1) > 0.5
 
 
+def test_a_late_tf_reader_gets_the_odometry_and_wheel_transforms() -> None:
+    # nobody reads /tf for the first seconds (the transforms are then not built); a reader
+    # that joins later gets odom -> base_footprint every odometry period, equal to /odom,
+    # and robot_state_publisher's wheel transforms
+    ctx = Context()
+    Simulation(context=ctx, world=_room(), robot="mybot")
+    cmd = ctx.create_node("driver").create_publisher(Twist, "/cmd_vel", 1)
+    cmd.publish(Twist(linear_x=0.2, angular_z=0.3))
+    ctx.spin_for(3.0)
+    got = _collect(ctx, {"/tf": "tf2_msgs/msg/TFMessage", "/odom": "nav_msgs/msg/Odometry"})
+    ctx.spin_for(2.0)
+    odom_tf = {
+        time_to_ns(t.header.stamp): t
+        for _, m in got["/tf"]
+        for t in m.transforms
+        if (t.header.frame_id, t.child_frame_id) == ("odom", "base_footprint")
+    }
+    assert len(odom_tf) == pytest.approx(60, abs=1)  # 30 Hz for 2 s
+    for _, m in got["/odom"]:
+        t = odom_tf[time_to_ns(m.header.stamp)]
+        assert t.transform.translation.x == m.pose.pose.position.x
+        assert t.transform.rotation.z == m.pose.pose.orientation.z
+    wheels = {t.child_frame_id for _, m in got["/tf"] for t in m.transforms} - {"base_footprint"}
+    assert wheels == {"left_wheel_link", "right_wheel_link"}
+
+
 def _drive_square(seed: int, slip: float) -> tuple[float, float, Any, Any]:
     """Open-loop 1 m square; returns (truth closure error, encoder closure error, ...)."""
     ctx = Context()

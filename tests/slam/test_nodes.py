@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from roverlab.core import Context, Node, QoSProfile, ServiceError, Time
+from roverlab.core import Context, Node, ServiceError, Time
 from roverlab.geometry import SE2, Transform3
 from roverlab.launch import LaunchError, build_launch
 from roverlab.msgs import String, Twist, make_scan, xytheta_from_pose
@@ -35,6 +35,7 @@ from roverlab.tf import (
     transform_to_msg,
 )
 from roverlab.world.yaml_world import world_from_dict
+from tests.helpers.nodes import collect
 
 FIXTURES = Path(__file__).parent / "fixtures"
 ROOM = {
@@ -58,14 +59,6 @@ def _room_map_quality(msg: Any, sim: Simulation) -> MapQuality:
     return evaluate_map(grid_from_msg(msg), gt)
 
 
-def _collect(ctx: Context, topics: dict[str, Any]) -> dict[str, list[Any]]:
-    got: dict[str, list[Any]] = {t: [] for t in topics}
-    node = ctx.create_node("collector")
-    for topic, typ in topics.items():
-        node.create_subscription(typ, topic, got[topic].append, QoSProfile(depth=1000))
-    return got
-
-
 def _drive(ctx: Context, steps: list[tuple[float, float, float]]) -> None:
     cmd = ctx.create_node("driver").create_publisher(Twist, "/cmd_vel", 1)
     for v, w, secs in steps:
@@ -81,7 +74,7 @@ def test_gmapping_node_in_the_simulator() -> None:
         context=ctx, world=_room(), robot="mybot", cameras=False, spawn=SpawnPose(-1.0, 0.0, 0.0)
     )
     node = SlamGMapping(ctx, parameter_overrides=FAST_GMAPPING)
-    got = _collect(
+    got = collect(
         ctx,
         {
             "/map_metadata": mc.MapMetaData,
@@ -259,7 +252,7 @@ def test_hector_node_in_the_simulator() -> None:
         ctx,
         parameter_overrides=SEED_HECTOR,
     )
-    got = _collect(
+    got = collect(
         ctx,
         {
             "/slam_out_pose": mc.PoseStamped,
@@ -331,7 +324,7 @@ def test_hector_without_tf_scan_transformation() -> None:
             "map_size": 512,
         },
     )
-    got = _collect(ctx, {"/tf": mc.TFMessage})
+    got = collect(ctx, {"/tf": mc.TFMessage})
     ctx.spin_for(1.0)
     assert node.scan_filter is None and node.scans_processed == 10
     frames = {t.child_frame_id for m in got["/tf"] for t in m.transforms}

@@ -20,7 +20,6 @@ import subprocess
 import sys
 import time
 import urllib.request
-from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -33,9 +32,9 @@ from PIL import Image
 from roverlab.core import Context
 from roverlab.launch import build_launch, load_launch
 from roverlab.world import BUNDLED_WORLDS_DIR
+from tests.helpers.browser import CHROMIUM
+from tests.helpers.procs import twist_pub_args
 
-CHROMIUM = Path("/usr/bin/chromium")
-CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--no-first-run"]
 ROVERLAB = str(Path(sys.executable).with_name("roverlab"))
 FACE_PNG = BUNDLED_WORLDS_DIR / "models/poster_face/materials/textures/face.png"
 
@@ -61,15 +60,6 @@ def _wait_http(url: str, timeout_s: float = 60.0) -> None:
         except OSError:
             time.sleep(0.3)
     raise AssertionError(f"{url} never answered")
-
-
-@pytest.fixture(scope="module")
-def browser() -> Iterator[Any]:
-    pw = playwright_sync.sync_playwright().start()
-    b = pw.chromium.launch(executable_path=str(CHROMIUM), args=CHROMIUM_ARGS)
-    yield b
-    b.close()
-    pw.stop()
 
 
 def _stop(p: subprocess.Popen[str]) -> None:
@@ -105,13 +95,7 @@ def test_seed_004_car_drives_in_the_dashboard(daemon: str, browser: Any, tmp_pat
         pub = subprocess.Popen(
             [
                 ROVERLAB,
-                "topic",
-                "pub",
-                "-r",
-                "10",
-                "/cmd_vel",
-                "geometry_msgs/Twist",
-                "{linear: {x: 0.2}, angular: {z: 0.5}}",
+                *twist_pub_args(0.2, 0.5),
             ],
             stdout=subprocess.PIPE,
             stderr=subprocess.PIPE,

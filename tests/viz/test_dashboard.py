@@ -42,18 +42,8 @@ from roverlab.tf import StaticTransformBroadcaster
 from roverlab.tf.convert import transform_to_msg
 from roverlab.viz import DashboardServer
 from roverlab.viz.config import DisplayConfig, default_config
+from tests.helpers.browser import CHROMIUM
 
-CHROMIUM = Path("/usr/bin/chromium")
-CHROMIUM_ARGS = [
-    "--headless",
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-quic",
-    "--no-first-run",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-]
 RESOLUTION_M = 0.05
 VIEWPORT = {"width": 1600, "height": 900}
 
@@ -230,17 +220,6 @@ def live(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Live]:
     )
     server.stop()
     ctx.shutdown()
-
-
-@pytest.fixture(scope="module")
-def browser() -> Iterator[Any]:
-    if not CHROMIUM.exists():
-        pytest.skip("/usr/bin/chromium is absent (run scripts/install-system-deps.sh)")
-    pw = playwright_sync.sync_playwright().start()
-    b = pw.chromium.launch(executable_path=str(CHROMIUM), args=CHROMIUM_ARGS)
-    yield b
-    b.close()
-    pw.stop()
 
 
 @pytest.fixture(scope="module")

@@ -13,6 +13,7 @@ Screenshots go to the tests' tmp dirs.
 
 from __future__ import annotations
 
+import contextlib
 import io
 import math
 import time
@@ -34,24 +35,14 @@ from roverlab.tf import StaticTransformBroadcaster
 from roverlab.tf.convert import transform_to_msg
 from roverlab.viz import DashboardServer
 from roverlab.viz.config import DisplayConfig, load_rviz
+from tests.helpers.browser import CHROMIUM
 
-CHROMIUM = Path("/usr/bin/chromium")
-CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--no-first-run"]
 VIEWPORT = {"width": 1400, "height": 860}
 MYCAR = Path(roverlab.packages.__file__).parent / "mycar"
 URDLEE = Path(__file__).parent / "fixtures" / "urdlee"
 
 playwright_sync = pytest.importorskip("playwright.sync_api", reason="playwright not installed")
 pytestmark = pytest.mark.skipif(not CHROMIUM.exists(), reason="/usr/bin/chromium is absent")
-
-
-@pytest.fixture(scope="module")
-def browser() -> Iterator[Any]:
-    pw = playwright_sync.sync_playwright().start()
-    b = pw.chromium.launch(executable_path=str(CHROMIUM), args=CHROMIUM_ARGS)
-    yield b
-    b.close()
-    pw.stop()
 
 
 def _open(browser: Any, server: DashboardServer, ready: str, timeout_ms: int = 60000) -> Any:
@@ -246,6 +237,25 @@ def _box_stl(path: Path, size: float) -> None:
     path.write_text("\n".join([*lines, "endsolid box"]) + "\n")
 
 
+@contextlib.contextmanager
+def _one_mesh_page(browser: Any, urdf: str) -> Iterator[Any]:
+    """A dashboard (showmycar.rviz: Orbit, fixed frame base_link) on a robot_state_publisher
+    of ``urdf`` and a page open on it once its one mesh has loaded."""
+    ctx = Context()
+    RobotStatePublisher(ctx, robot_description=urdf)
+    config = load_rviz(URDLEE / "config" / "showmycar.rviz")
+    server = DashboardServer(ctx, "127.0.0.1", 0, config=config)
+    ctx.spin_in_thread()
+    server.start()
+    try:
+        page = _open(browser, server, "viz.meshes.loaded + viz.meshes.failed > 0")
+        assert page.evaluate("() => viz.meshes") == {"loaded": 1, "failed": 0}
+        yield page
+    finally:
+        server.stop()
+        ctx.shutdown()
+
+
 def test_stl_mesh_visual_is_loaded_and_drawn(browser: Any, tmp_path: Path) -> None:
     stl = tmp_path / "body.stl"
     _box_stl(stl, 0.4)
@@ -253,15 +263,7 @@ def test_stl_mesh_visual_is_loaded_and_drawn(browser: Any, tmp_path: Path) -> No
       <link name="base_link"><visual><geometry><mesh filename="file://{stl}"/></geometry>
         <material name="red"><color rgba="1 0 0 1"/></material></visual></link>
     </robot>"""
-    ctx = Context()
-    RobotStatePublisher(ctx, robot_description=urdf)
-    config = load_rviz(URDLEE / "config" / "showmycar.rviz")  # Orbit, fixed frame base_link
-    server = DashboardServer(ctx, "127.0.0.1", 0, config=config)
-    ctx.spin_in_thread()
-    server.start()
-    try:
-        page = _open(browser, server, "viz.meshes.loaded + viz.meshes.failed > 0")
-        assert page.evaluate("() => viz.meshes") == {"loaded": 1, "failed": 0}
+    with _one_mesh_page(browser, urdf) as page:
         page.evaluate("() => { viz.cam.distance = 2.0; viz.cam.focal.set(0, 0, 0); }")
         page.wait_for_timeout(500)
         img = _shot(page, tmp_path / "stl_mesh.png")
@@ -271,9 +273,6 @@ def test_stl_mesh_visual_is_loaded_and_drawn(browser: Any, tmp_path: Path) -> No
         assert red > 100, "the red STL box is not drawn at base_link"
         assert not page.errors
         page.close()
-    finally:
-        server.stop()
-        ctx.shutdown()
 
 
 def test_collada_mesh_visual_keeps_its_colour_and_z_up(browser: Any, tmp_path: Path) -> None:
@@ -284,15 +283,7 @@ def test_collada_mesh_visual_keeps_its_colour_and_z_up(browser: Any, tmp_path: P
       <link name="base_link"><visual><geometry><mesh filename="file://{dae}" scale="3 3 3"/>
       </geometry></visual></link>
     </robot>"""
-    ctx = Context()
-    RobotStatePublisher(ctx, robot_description=urdf)
-    config = load_rviz(URDLEE / "config" / "showmycar.rviz")  # Orbit, fixed frame base_link
-    server = DashboardServer(ctx, "127.0.0.1", 0, config=config)
-    ctx.spin_in_thread()
-    server.start()
-    try:
-        page = _open(browser, server, "viz.meshes.loaded + viz.meshes.failed > 0")
-        assert page.evaluate("() => viz.meshes") == {"loaded": 1, "failed": 0}
+    with _one_mesh_page(browser, urdf) as page:
         page.evaluate(
             "() => { viz.cam.distance = 2.5; viz.cam.focal.set(0, 0, 0);"
             " viz.cam.pitch = 1.45; viz.cam.yaw = 0; }"
@@ -310,6 +301,3 @@ def test_collada_mesh_visual_keeps_its_colour_and_z_up(browser: Any, tmp_path: P
         assert not red_at(0.3, 0.0) and not red_at(-0.3, 0.0)
         assert not page.errors
         page.close()
-    finally:
-        server.stop()
-        ctx.shutdown()

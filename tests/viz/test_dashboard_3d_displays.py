@@ -29,7 +29,7 @@ from roverlab.tf.convert import transform_to_msg
 from roverlab.viz import DashboardServer
 from roverlab.viz.config import DashboardConfig, DisplayConfig
 
-from .test_dashboard_3d import _open, _screen, _shot, browser  # noqa: F401 (fixture)
+from .test_dashboard_3d import _open, _screen, _shot
 
 BOX_URDF = """<robot name="boxbot"><link name="base_link"><visual><geometry>
   <box size="0.3 0.2 0.1"/></geometry></visual></link></robot>"""
@@ -172,7 +172,7 @@ def _colour_near(img: np.ndarray, sx: float, sy: float, r: int = 4) -> np.ndarra
 
 def test_intensity_scan_markers_and_poses_in_3d(
     scene: tuple[DashboardServer, _Feed],
-    browser: Any,  # noqa: F811
+    browser: Any,
     tmp_path: Path,
 ) -> None:
     server, feed = scene

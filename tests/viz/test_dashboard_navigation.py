@@ -21,7 +21,8 @@ from roverlab.navigation.move_base.node import MoveBase
 from roverlab.sim.node import SimulatorNode
 from roverlab.viz import DashboardServer
 from roverlab.viz.config import load_rviz
-from tests.viz.test_dashboard import CHROMIUM, CHROMIUM_ARGS, VIEWPORT, _wait
+from tests.helpers.browser import CHROMIUM, CHROMIUM_ARGS
+from tests.viz.test_dashboard import VIEWPORT, _wait
 
 playwright_sync = pytest.importorskip("playwright.sync_api", reason="playwright not installed")
 

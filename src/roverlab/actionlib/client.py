@@ -12,7 +12,7 @@ import threading
 from collections.abc import Callable
 from typing import Any, Final
 
-from roverlab.actionlib.status import GoalIDGenerator, GoalStatus, status_name
+from roverlab.actionlib.status import TERMINAL_STATES, GoalIDGenerator, GoalStatus, status_name
 from roverlab.core import Node, Time
 from roverlab.msgs import ActionType, get_action_type, get_factory
 
@@ -253,19 +253,7 @@ class ClientGoalHandle:
             self._m.client.node.get_logger().warning(
                 f"Asking for the terminal state when we're in {CommState.NAMES[self._m.state]}"
             )
-        return (
-            status
-            if status
-            in (
-                GoalStatus.PREEMPTED,
-                GoalStatus.SUCCEEDED,
-                GoalStatus.ABORTED,
-                GoalStatus.REJECTED,
-                GoalStatus.RECALLED,
-                GoalStatus.LOST,
-            )
-            else GoalStatus.LOST
-        )
+        return status if status in TERMINAL_STATES else GoalStatus.LOST
 
 
 class ActionClient:

@@ -35,18 +35,10 @@ class GoalStatus:
     LOST: Final[int] = int(_GOAL_STATUS.LOST)
 
 
-#: State names by value, as slam.py's ``goal_states`` list spells them.
-STATUS_NAMES: Final[tuple[str, ...]] = (
-    "PENDING",
-    "ACTIVE",
-    "PREEMPTED",
-    "SUCCEEDED",
-    "ABORTED",
-    "REJECTED",
-    "PREEMPTING",
-    "RECALLING",
-    "RECALLED",
-    "LOST",
+#: State names by value (the message's constant names, as slam.py's ``goal_states`` list
+#: spells them).
+STATUS_NAMES: Final[tuple[str, ...]] = tuple(
+    sorted(_GOAL_STATUS.constants, key=_GOAL_STATUS.constants.__getitem__)
 )
 
 #: The states a goal ends in.

@@ -11,6 +11,7 @@ import numpy as np
 import typer
 from PIL import Image, ImageDraw
 
+from roverlab.cli.apps import command_app
 from roverlab.cli.log_input import (
     BaseFrameOption,
     FirstOption,
@@ -42,12 +43,10 @@ from roverlab.slam.data.trajectory import read_tum, write_tum
 
 __all__ = ["app", "run"]
 
-app = typer.Typer(
+app = command_app(
     name="amcl",
     help="Localization on a known map (ROS 1 amcl), offline on recorded logs.",
     no_args_is_help=True,
-    pretty_exceptions_enable=False,
-    context_settings={"help_option_names": ["-h", "--help"]},
 )
 
 _INITIAL_PARAMS = ("initial_pose_x", "initial_pose_y", "initial_pose_a")

@@ -13,6 +13,7 @@ from typing import Any
 
 import typer
 
+from roverlab.bag import McapRecorder
 from roverlab.core import Context
 from roverlab.core.errors import TransportError
 from roverlab.core.transport.daemon import ensure_daemon
@@ -29,8 +30,10 @@ __all__ = [
     "FOLLOWER_CLOCKS",
     "Connection",
     "NetworkOptions",
+    "StartGuard",
     "choose_expose",
     "connect_following_clock",
+    "expose_if_asked",
     "is_loopback_endpoint",
     "network_options",
     "run_context",
@@ -221,6 +224,41 @@ def choose_expose(expose: bool | None, pace: float) -> bool:
         )
         return False
     return True
+
+
+def expose_if_asked(ctx: typer.Context, context: Context, expose: bool | None, pace: float) -> None:
+    """Attach ``context`` to the network (Zenoh, the command's network options) when
+    :func:`choose_expose` says so."""
+    if choose_expose(expose, pace):
+        context.add_transport(ZenohTransport(network_options(ctx).zenoh_options()))
+
+
+class StartGuard:
+    """Undoes a run's start-up when a block under ``with guard:`` raises anything (Ctrl-C
+    included): aborts the recording, if any, and shuts the context down; then re-raises.
+
+    Args:
+        context: the run's context.
+        recorder: a recording already attached, if any (or attach one with :meth:`record`).
+    """
+
+    def __init__(self, context: Context, recorder: McapRecorder | None = None) -> None:
+        self.context = context
+        self.recorder = recorder
+
+    def record(self, path: Any) -> None:
+        """Record the run to ``path`` (MCAP)."""
+        self.recorder = McapRecorder(path)
+        self.context.add_transport(self.recorder)
+
+    def __enter__(self) -> StartGuard:
+        return self
+
+    def __exit__(self, exc_type: type[BaseException] | None, *_: object) -> None:
+        if exc_type is not None:
+            if self.recorder is not None:
+                self.recorder.abort()
+            self.context.shutdown()
 
 
 def connect_following_clock(options: NetworkOptions, clock: str) -> tuple[ZenohTransport, str, str]:

@@ -11,10 +11,9 @@ import typer
 
 from roverlab.autonomy.story import DemoStory
 from roverlab.bag import McapRecorder
-from roverlab.cli.common import choose_expose, network_options, stop_on_signals
+from roverlab.cli.common import StartGuard, expose_if_asked, stop_on_signals
 from roverlab.cli.sim import parse_rate
 from roverlab.core import Context, configure_logging
-from roverlab.core.transport.zenoh import ZenohTransport
 from roverlab.description import find_package
 from roverlab.errors import RoverlabError
 from roverlab.viz.config import DisplayConfig, load_rviz
@@ -73,7 +72,7 @@ def demo(
     context = Context(clock="sim") if math.isinf(pace) else Context(clock="paced", rate=pace)
     recorder = McapRecorder(out / "run.mcap")
     server: DashboardServer | None = None
-    try:
+    with StartGuard(context, recorder):
         context.add_transport(recorder)
         if dashboard:
             config = load_rviz(find_package("robot_navigation") / "rviz" / "navigation.rviz")
@@ -83,14 +82,9 @@ def demo(
             server = DashboardServer(context, "127.0.0.1", port, config=config, map_dir=out)
             server.start()
             typer.echo(f"dashboard: {server.url}  (open it in a browser)")
-        if choose_expose(expose, pace):
-            context.add_transport(ZenohTransport(network_options(ctx).zenoh_options()))
+        expose_if_asked(ctx, context, expose, pace)
         story = DemoStory(context, out, places=places, seed=seed, log=typer.echo)
         story.start()
-    except BaseException:
-        recorder.abort()
-        context.shutdown()
-        raise
     typer.echo(f"roverlab demo: mybot in seed 003's maze, rate {rate}; writing {out}/")
     context.spin_in_thread()
     with stop_on_signals(threading.Event()) as stop:

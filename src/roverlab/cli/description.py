@@ -64,6 +64,7 @@ XacroNsOption = Annotated[
         "accepted with its deprecation warning).",
     ),
 ]
+MappingsArgument = Annotated[list[str] | None, typer.Argument(help="xacro arguments, name:=value.")]
 InorderOption = Annotated[
     bool,
     typer.Option(
@@ -77,9 +78,7 @@ InorderOption = Annotated[
 @app.command("check")
 def check(
     file: Annotated[Path, typer.Argument(help="A .urdf, .xacro or .urdf.xacro file.")],
-    mappings: Annotated[
-        list[str] | None, typer.Argument(help="xacro arguments, name:=value.")
-    ] = None,
+    mappings: MappingsArgument = None,
     arg: Annotated[
         list[str] | None,
         typer.Option("--arg", "-a", help="A xacro argument, name:=value (repeatable)."),
@@ -100,9 +99,7 @@ def check(
 @app.command("xacro")
 def xacro(
     file: Annotated[Path, typer.Argument(help="The xacro file to expand.")],
-    mappings: Annotated[
-        list[str] | None, typer.Argument(help="xacro arguments, name:=value.")
-    ] = None,
+    mappings: MappingsArgument = None,
     output: Annotated[
         Path | None, typer.Option("--output", "-o", help="Write to this file, not stdout.")
     ] = None,

@@ -8,11 +8,9 @@ from typing import Annotated
 
 import typer
 
-from roverlab.bag import McapRecorder
-from roverlab.cli.common import choose_expose, network_options, report_warnings, run_context
+from roverlab.cli.common import StartGuard, expose_if_asked, report_warnings, run_context
 from roverlab.cli.sim import parse_rate
 from roverlab.core import Context, configure_logging
-from roverlab.core.transport.zenoh import ZenohTransport
 from roverlab.description import find_package
 from roverlab.launch import LaunchError, LaunchSpec, build_launch, load_launch
 
@@ -130,28 +128,16 @@ def launch(
     if note:
         typer.echo(f"note: {note}", err=True)
     context = Context(clock=mode, rate=1.0 if math.isinf(pace) else pace)
-    recorder = None
-    try:
+    guard = StartGuard(context)
+    with guard:
         if record is not None:
-            recorder = McapRecorder(record)
-            context.add_transport(recorder)
+            guard.record(record)
         started = build_launch(spec, context=context, seed=seed)
-        if choose_expose(expose, pace):
-            context.add_transport(ZenohTransport(network_options(ctx).zenoh_options()))
-    except BaseException:
-        if recorder is not None:
-            recorder.abort()
-        context.shutdown()
-        raise
-    try:
+        expose_if_asked(ctx, context, expose, pace)
+    with guard:
         report_warnings(f"launch {path.name}", started.warnings, strict)
         report_warnings("Gazebo world", started.world_warnings, strict)
         report_warnings("spawned robot", started.robot_warnings, strict)
-    except BaseException:
-        if recorder is not None:
-            recorder.abort()
-        context.shutdown()
-        raise
     names = ", ".join(n.get_fully_qualified_name() for n in started.nodes)
     typer.echo(f"started {len(started.nodes)} nodes: {names}", err=True)
     started.supervise()

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import sys
 from typing import Annotated
 
 import typer
@@ -32,15 +31,13 @@ from roverlab.cli import maps as map_cli
 from roverlab.cli import slam as slam_cli
 from roverlab.cli import teleop as teleop_cli
 from roverlab.cli import viz as viz_cli
+from roverlab.cli.apps import command_app, run_app
 from roverlab.cli.common import NetworkOptions
-from roverlab.errors import RoverlabError
 
-app = typer.Typer(
+app = command_app(
     name="roverlab",
     help="The classic ROS mobile-robot stack, pip-installable, no ROS needed.",
     no_args_is_help=True,
-    pretty_exceptions_enable=False,
-    context_settings={"help_option_names": ["-h", "--help"]},
 )
 app.add_typer(topic.app, name="topic")
 app.add_typer(service.app, name="service")
@@ -145,8 +142,4 @@ def root(
 
 def main(argv: list[str] | None = None) -> None:
     """Entry point: user errors become one line on stderr and exit code 2."""
-    try:
-        app(args=argv, prog_name="roverlab", standalone_mode=True)
-    except RoverlabError as err:
-        print(f"error: {err}", file=sys.stderr)
-        sys.exit(2)
+    run_app(app, argv, "roverlab")

@@ -14,29 +14,26 @@ map and writes it.
 from __future__ import annotations
 
 import math
-import sys
 from pathlib import Path
 from typing import Annotated
 
 import typer
 
+from roverlab.cli.apps import command_app, run_app
 from roverlab.cli.common import Connection, network_options, run_context
 from roverlab.core import Context, configure_logging
 from roverlab.core.graph import resolve_name
 from roverlab.core.transport.zenoh import ZenohTransport
-from roverlab.errors import RoverlabError
 from roverlab.maps.errors import MapError
 from roverlab.maps.map_io import ImageFormat, check_save_thresholds, load_map
 from roverlab.maps.node import MapSaver, MapServer
 
 __all__ = ["app", "main"]
 
-app = typer.Typer(
+app = command_app(
     help="Serve, save and inspect map_server maps (YAML + PGM/PNG).",
     no_args_is_help=True,
     add_completion=False,
-    pretty_exceptions_enable=False,
-    context_settings={"help_option_names": ["-h", "--help"]},
 )
 
 
@@ -155,8 +152,4 @@ def info(
 
 def main(argv: list[str] | None = None) -> None:
     """``roverlab map`` on its own: user errors become one line on stderr and exit code 2."""
-    try:
-        app(args=argv, prog_name="roverlab map", standalone_mode=True)
-    except RoverlabError as err:
-        print(f"error: {err}", file=sys.stderr)
-        sys.exit(2)
+    run_app(app, argv, "roverlab map")

@@ -10,6 +10,7 @@ from typing import Annotated
 
 import typer
 
+from roverlab.cli.apps import command_app
 from roverlab.cli.batch import (
     EpisodesOption,
     RayAddressOption,
@@ -23,12 +24,10 @@ from roverlab.navbench.batch import PLOT_COLUMNS, nav_episode
 
 __all__ = ["app", "bench"]
 
-app = typer.Typer(
+app = command_app(
     name="nav",
     help="Navigation (move_base) tools: the benchmark.",
     no_args_is_help=True,
-    pretty_exceptions_enable=False,
-    context_settings={"help_option_names": ["-h", "--help"]},
 )
 
 

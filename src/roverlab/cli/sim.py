@@ -9,16 +9,14 @@ from typing import Annotated
 
 import typer
 
-from roverlab.bag import McapRecorder
 from roverlab.cli.common import (
-    choose_expose,
-    network_options,
+    StartGuard,
+    expose_if_asked,
     report_warnings,
     run_context,
     stop_on_signals,
 )
 from roverlab.core import Context, configure_logging
-from roverlab.core.transport.zenoh import ZenohTransport
 from roverlab.description.check import robot_warnings
 from roverlab.sim.app import Simulation, SimulationError
 from roverlab.sim.node import SpawnPose
@@ -161,11 +159,10 @@ def _run(
     duration: float | None,
     strict: bool,
 ) -> None:
-    recorder: McapRecorder | None = None
-    try:
+    guard = StartGuard(context)
+    with guard:
         if record is not None:
-            recorder = McapRecorder(record)
-            context.add_transport(recorder)
+            guard.record(record)
         simulation = Simulation(
             context=context,
             world=world,
@@ -180,13 +177,8 @@ def _run(
         report_warnings(
             f"robot {simulation.robot_model.name}", robot_warnings(simulation.robot_model), strict
         )
-        if choose_expose(expose, pace):
-            context.add_transport(ZenohTransport(network_options(ctx).zenoh_options()))
-    except BaseException:
-        if recorder is not None:
-            recorder.abort()
-        context.shutdown()
-        raise
+        expose_if_asked(ctx, context, expose, pace)
+    recorder = guard.recorder
     cfg = simulation.config
     sensors = [s.topic for s in cfg.lidars] + [s.topic for s in cfg.imus]
     sensors += [c.image_topic for c in cfg.cameras] + [d.points_topic for d in cfg.depth_cameras]

@@ -20,7 +20,7 @@ from typing import Annotated
 
 import typer
 
-from roverlab.errors import RoverlabError
+from roverlab.cli.apps import command_app, run_app
 from roverlab.slam.data.errors import LogError
 from roverlab.slam.data.evaluation import evaluate, read_relations
 from roverlab.slam.data.logs import load_log
@@ -30,12 +30,10 @@ from roverlab.slam.data.trajectory import read_tum, write_tum
 
 __all__ = ["app", "eval_command", "graph_command", "main", "odometry_command"]
 
-app = typer.Typer(
+app = command_app(
     name="slam",
     help="SLAM data: score trajectories (Kuemmerle metric), optimise g2o pose graphs.",
     no_args_is_help=True,
-    pretty_exceptions_enable=False,
-    context_settings={"help_option_names": ["-h", "--help"]},
 )
 
 
@@ -134,8 +132,4 @@ def odometry_command(
 
 def main(argv: list[str] | None = None) -> None:
     """``roverlab slam``: user errors become one line on stderr and exit code 2."""
-    try:
-        app(args=argv, prog_name="roverlab slam", standalone_mode=True)
-    except RoverlabError as err:
-        print(f"error: {err}", file=sys.stderr)
-        sys.exit(2)
+    run_app(app, argv, "roverlab slam")

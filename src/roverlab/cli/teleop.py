@@ -27,9 +27,9 @@ from typing import Annotated, Any, Final
 import typer
 import yaml
 
+from roverlab.cli.apps import command_app, run_app
 from roverlab.cli.common import Connection, network_options
 from roverlab.core.graph import resolve_name, validate_node_name
-from roverlab.errors import RoverlabError
 from roverlab.teleop.errors import TeleopError
 from roverlab.teleop.keyboard import check_speed
 from roverlab.teleop.node import (
@@ -205,19 +205,13 @@ def teleop(
         raise typer.Exit(code)
 
 
-app = typer.Typer(
+app = command_app(
     name="teleop",
     add_completion=False,
-    pretty_exceptions_enable=False,
-    context_settings={"help_option_names": ["-h", "--help"]},
 )
 app.command("teleop")(teleop)
 
 
 def main(argv: list[str] | None = None) -> None:
     """``roverlab teleop`` on its own: user errors become one line on stderr and exit code 2."""
-    try:
-        app(args=argv, prog_name="roverlab teleop", standalone_mode=True)
-    except RoverlabError as err:
-        print(f"error: {err}", file=sys.stderr)
-        sys.exit(2)
+    run_app(app, argv, "roverlab teleop")

@@ -80,7 +80,12 @@ class Publisher:
         topic = self.topic
         topic.published += 1
         for sub in topic.subscriptions:
-            sub._enqueue(msg)
+            # Subscription._enqueue, inlined (this runs for every delivery)
+            q = sub._queue
+            if len(q) == sub.depth:
+                sub.dropped += 1
+            q.append(msg)
+            sub._ready.append((next(sub._seq), sub._take_ref))
         if self.history is not None:
             self.history.append(msg)
         send = topic.remote_send

@@ -34,9 +34,9 @@ from roverlab.description.errors import (
     URDFError,
     XacroError,
 )
-from roverlab.description.gazebo import (
+from roverlab.description.gazebo import PLUGIN_SPECS
+from roverlab.description.gazebo_specs import (
     GAZEBO_MATERIALS,
-    PLUGIN_SPECS,
     SENSOR_TYPES,
     CameraPluginSpec,
     CameraSpec,

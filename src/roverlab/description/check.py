@@ -18,7 +18,7 @@ from __future__ import annotations
 import math
 
 from roverlab.description.errors import DescriptionError
-from roverlab.description.gazebo import (
+from roverlab.description.gazebo_specs import (
     CameraPluginSpec,
     DiffDriveSpec,
     GazeboPlugin,

@@ -32,9 +32,7 @@ from typing import Final
 
 from roverlab.description.errors import URDFError
 from roverlab.description.gazebo_specs import (
-    GAZEBO_MATERIALS,
     NOISE_TYPES,
-    SENSOR_TYPES,
     CameraPluginSpec,
     CameraSpec,
     DiffDriveSpec,
@@ -50,36 +48,12 @@ from roverlab.description.gazebo_specs import (
     PluginSpec,
     RaySpec,
     ScanAxis,
-    gazebo_material_rgba,
     resolve_frame,
     resolve_topic,
 )
 from roverlab.geometry import Transform3, quat_from_rpy
 
-__all__ = [
-    "GAZEBO_MATERIALS",
-    "PLUGIN_SPECS",
-    "SENSOR_TYPES",
-    "CameraPluginSpec",
-    "CameraSpec",
-    "DiffDriveSpec",
-    "GazeboExtensions",
-    "GazeboPlugin",
-    "GazeboReference",
-    "GazeboSensor",
-    "ImuPluginSpec",
-    "ImuSpec",
-    "KinectPluginSpec",
-    "LaserPluginSpec",
-    "NoiseSpec",
-    "PluginSpec",
-    "RaySpec",
-    "ScanAxis",
-    "gazebo_material_rgba",
-    "parse_gazebo",
-    "resolve_frame",
-    "resolve_topic",
-]
+__all__ = ["PLUGIN_SPECS", "parse_gazebo"]
 
 
 # --------------------------------------------------------------------------- parsing
@@ -320,6 +294,11 @@ def _distortion(v: _Values, name: str) -> float:
     return v.number(camel, v.number(snake, 0.0))
 
 
+def _distortions(v: _Values) -> dict[str, float]:
+    """The five ``distortion_*`` fields of a camera plugin spec."""
+    return {f"distortion_{k}": _distortion(v, k) for k in ("k1", "k2", "k3", "t1", "t2")}
+
+
 def _camera_plugin(v: _Values, plugin: GazeboPlugin) -> CameraPluginSpec:
     ns = v.text("robotNamespace", "")
     name = v.text("cameraName", "")
@@ -331,11 +310,7 @@ def _camera_plugin(v: _Values, plugin: GazeboPlugin) -> CameraPluginSpec:
         frame_id=resolve_frame(ns, v.text("frameName", "/world")),
         update_rate_hz=v.non_negative("updateRate", 0.0),
         hack_baseline=v.number("hackBaseline", 0.0),
-        distortion_k1=_distortion(v, "k1"),
-        distortion_k2=_distortion(v, "k2"),
-        distortion_k3=_distortion(v, "k3"),
-        distortion_t1=_distortion(v, "t1"),
-        distortion_t2=_distortion(v, "t2"),
+        **_distortions(v),
         robot_namespace=ns,
     )
 
@@ -358,11 +333,7 @@ def _kinect(v: _Values, plugin: GazeboPlugin) -> KinectPluginSpec:
         point_cloud_cutoff_m=v.non_negative("pointCloudCutoff", 0.4),
         point_cloud_cutoff_max_m=v.non_negative("pointCloudCutoffMax", 5.0),
         update_rate_hz=v.non_negative("updateRate", 0.0),
-        distortion_k1=_distortion(v, "k1"),
-        distortion_k2=_distortion(v, "k2"),
-        distortion_k3=_distortion(v, "k3"),
-        distortion_t1=_distortion(v, "t1"),
-        distortion_t2=_distortion(v, "t2"),
+        **_distortions(v),
         robot_namespace=ns,
     )
     if spec.point_cloud_cutoff_max_m < spec.point_cloud_cutoff_m:

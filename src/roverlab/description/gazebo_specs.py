@@ -14,30 +14,6 @@ from typing import Final, Literal, TypeVar
 
 from roverlab.geometry import Transform3
 
-__all__ = [
-    "GAZEBO_MATERIALS",
-    "NOISE_TYPES",
-    "SENSOR_TYPES",
-    "CameraPluginSpec",
-    "CameraSpec",
-    "DiffDriveSpec",
-    "GazeboExtensions",
-    "GazeboPlugin",
-    "GazeboReference",
-    "GazeboSensor",
-    "ImuPluginSpec",
-    "ImuSpec",
-    "KinectPluginSpec",
-    "LaserPluginSpec",
-    "NoiseSpec",
-    "PluginSpec",
-    "RaySpec",
-    "ScanAxis",
-    "gazebo_material_rgba",
-    "resolve_frame",
-    "resolve_topic",
-]
-
 SENSOR_TYPES: Final = frozenset({"ray", "gpu_ray", "camera", "depth", "imu"})
 """Sensor types roverlab reads into typed specs (others are kept, listed as unsupported)."""
 

@@ -23,29 +23,8 @@ from types import MappingProxyType
 from typing import Final
 
 from roverlab.description.errors import URDFError
-from roverlab.description.gazebo import GazeboExtensions
+from roverlab.description.gazebo_specs import GazeboExtensions
 from roverlab.geometry import Transform3
-
-__all__ = [
-    "MOVABLE_JOINT_TYPES",
-    "Box",
-    "Collision",
-    "Cylinder",
-    "Geometry",
-    "Inertial",
-    "Joint",
-    "JointDynamics",
-    "JointLimit",
-    "JointMimic",
-    "JointSafety",
-    "JointType",
-    "Link",
-    "Material",
-    "Mesh",
-    "RobotModel",
-    "Sphere",
-    "Visual",
-]
 
 Vec3 = tuple[float, float, float]
 RGBA = tuple[float, float, float, float]

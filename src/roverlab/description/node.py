@@ -168,13 +168,6 @@ class RobotStatePublisher(Node):
             ),
         )
 
-    def _joint_msg(self, joint: Joint, stamp_ns: int, position: float) -> Any:
-        spec = self._revolute.get(joint.name)
-        if spec is None:
-            return self._msg(joint, Time(stamp_ns), position)
-        sec, nanosec = divmod(stamp_ns, 1_000_000_000)
-        return self._revolute_msg(spec, sec, nanosec, position)
-
     def publish_fixed_transforms(self) -> None:
         """(Re)publish every fixed joint on ``/tf_static``, stamped now."""
         now = self.get_clock().now()
@@ -215,13 +208,21 @@ class RobotStatePublisher(Node):
                 updated[mimic.name] = mimic
         for name in names:
             self._last_published[name] = stamp_ns
-        if updated:
-            self._tf.send_transform(
-                [
-                    self._joint_msg(j, stamp_ns, self.model.joint_position(j, self._positions))
-                    for j in updated.values()
-                ]
-            )
+        # transforms are built only when someone reads /tf (here or in another process)
+        if updated and self._tf.publisher.has_listeners:
+            sec, nanosec = divmod(stamp_ns, 1_000_000_000)
+            revolute, known = self._revolute, self._positions
+            position_of = self.model.joint_position
+            msgs = []
+            for j in updated.values():
+                spec = revolute.get(j.name)
+                q = position_of(j, known)
+                msgs.append(
+                    self._msg(j, Time(stamp_ns), q)
+                    if spec is None
+                    else self._revolute_msg(spec, sec, nanosec, q)
+                )
+            self._tf.publisher.publish(mc.TFMessage(msgs))
 
 
 class JointStatePublisher(Node):

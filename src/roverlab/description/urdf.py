@@ -27,7 +27,8 @@ from collections.abc import Iterable, Mapping
 from pathlib import Path
 
 from roverlab.description.errors import URDFError
-from roverlab.description.gazebo import DiffDriveSpec, ImuPluginSpec, parse_gazebo
+from roverlab.description.gazebo import parse_gazebo
+from roverlab.description.gazebo_specs import DiffDriveSpec, ImuPluginSpec
 from roverlab.description.model import (
     Box,
     Collision,
@@ -50,8 +51,6 @@ from roverlab.description.model import (
 from roverlab.description.packages import PackagePath
 from roverlab.description.xacro_hook import xacro_file, xacro_string
 from roverlab.geometry import Transform3, quat_from_rpy
-
-__all__ = ["load_robot", "parse_urdf", "robot_description"]
 
 PathOrXML = str | os.PathLike[str]
 _JOINT_TYPES = {t.value: t for t in JointType}

@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import hashlib
 import os
-import tempfile
 import threading
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
@@ -34,6 +33,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from roverlab.errors import RoverlabError
+from roverlab.fileio import atomic_write
 from roverlab.geometry import Transform3
 
 __all__ = [
@@ -136,17 +136,17 @@ def _write_cache(cache: Path, parts: tuple[MeshPart, ...]) -> None:
     """Atomic write (temp + rename); a cache that cannot be written is only slower."""
     try:
         cache.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=cache.parent, suffix=".tmp.npz")
-        with os.fdopen(fd, "wb") as f:
-            np.savez(
+        atomic_write(
+            cache,
+            lambda f: np.savez(
                 f,
                 counts=np.array([len(q.hull) for q in parts], dtype=np.int64),
                 vertices=np.concatenate([q.hull for q in parts]) if parts else np.zeros((0, 3)),
                 rgb=np.array(
                     [q.rgb if q.rgb else (-1, -1, -1) for q in parts], dtype=np.int64
                 ).reshape(-1, 3),
-            )
-        os.replace(tmp, cache)
+            ),
+        )
     except OSError:
         return
 

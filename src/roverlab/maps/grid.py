@@ -45,7 +45,14 @@ from roverlab.maps.errors import GridError
 from roverlab.msgs import array_to_occupancy_grid
 from roverlab.msgs import classes as mc
 
-__all__ = ["CountGrid", "LogOddsGrid", "ScanRays", "trace_cells", "trace_segment_cells"]
+__all__ = [
+    "CountGrid",
+    "LogOddsGrid",
+    "ScanRays",
+    "scan_arrays",
+    "trace_cells",
+    "trace_segment_cells",
+]
 
 _jit = numba.njit(cache=True, nogil=True)
 
@@ -224,6 +231,23 @@ def trace_cells(
 
 
 # ------------------------------------------------------------------------------- geometry
+def scan_arrays(
+    ranges: ArrayLike, angles: ArrayLike, error: type[Exception]
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """A scan's ranges and beam angles as flat float64 arrays.
+
+    Raises:
+        error: ``"<n> ranges but <m> angles"`` or ``"beam angles must be finite"``.
+    """
+    r = np.asarray(ranges, dtype=np.float64).ravel()
+    a = np.asarray(angles, dtype=np.float64).ravel()
+    if r.shape != a.shape:
+        raise error(f"{r.size} ranges but {a.size} angles")
+    if not np.all(np.isfinite(a)):
+        raise error("beam angles must be finite")
+    return r, a
+
+
 class ScanRays:
     """The beams of one scan that update a grid, in world coordinates.
 
@@ -249,12 +273,7 @@ class ScanRays:
         p = np.asarray(pose, dtype=np.float64).ravel()
         if p.shape != (3,) or not np.all(np.isfinite(p)):
             raise GridError(f"pose must be three finite numbers (x, y, theta), got {pose!r}")
-        r = np.asarray(ranges, dtype=np.float64).ravel()
-        a = np.asarray(angles, dtype=np.float64).ravel()
-        if r.shape != a.shape:
-            raise GridError(f"{r.size} ranges but {a.size} angles")
-        if not np.all(np.isfinite(a)):
-            raise GridError("beam angles must be finite")
+        r, a = scan_arrays(ranges, angles, GridError)
         if not (math.isfinite(range_max) and range_max > 0):
             raise GridError(f"range_max must be a positive number of metres, got {range_max}")
         if not (math.isfinite(range_min) and range_min >= 0):

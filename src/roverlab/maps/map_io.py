@@ -54,27 +54,6 @@ from roverlab.maps.errors import MapError
 from roverlab.msgs import array_to_occupancy_grid, occupancy_grid_to_array
 from roverlab.msgs import classes as mc
 
-__all__ = [
-    "CellCounts",
-    "ImageFormat",
-    "MapInfo",
-    "MapMode",
-    "OccupancyMap",
-    "SavedMap",
-    "cell_counts",
-    "check_save_thresholds",
-    "format_map_yaml",
-    "image_to_occupancy",
-    "load_map",
-    "occupancy_to_image",
-    "pgm_bytes",
-    "read_image_pixels",
-    "read_map_yaml",
-    "save_map",
-    "save_occupancy_grid",
-    "yaw_of_quaternion",
-]
-
 ImageFormat = Literal["pgm", "png"]
 
 #: Pixel values map_saver writes.
@@ -142,8 +121,24 @@ class CellCounts(NamedTuple):
     other: int
 
 
+class GridShape:
+    """``width`` and ``height`` (cells) of a class whose ``data`` is a ``(height, width)``
+    array, row 0 at the origin (``OccupancyGrid`` order)."""
+
+    __slots__ = ()
+    data: NDArray[Any]
+
+    @property
+    def width(self) -> int:
+        return int(self.data.shape[1])
+
+    @property
+    def height(self) -> int:
+        return int(self.data.shape[0])
+
+
 @dataclass(frozen=True, slots=True)
-class OccupancyMap:
+class OccupancyMap(GridShape):
     """A loaded map: its settings and its cells.
 
     Attributes:
@@ -153,14 +148,6 @@ class OccupancyMap:
 
     info: MapInfo
     data: NDArray[np.int8]
-
-    @property
-    def width(self) -> int:
-        return int(self.data.shape[1])
-
-    @property
-    def height(self) -> int:
-        return int(self.data.shape[0])
 
     def counts(self) -> CellCounts:
         return cell_counts(self.data)

@@ -41,18 +41,6 @@ from roverlab.sim.app import Simulation
 from roverlab.sim.node import SimulatorNode, SpawnPose
 from roverlab.world import World, load_world
 
-__all__ = [
-    "LOCALIZATIONS",
-    "PARAM_SETS",
-    "PLANNERS",
-    "SUCCESS_RADIUS_M",
-    "TIMING_KEYS",
-    "BenchConfig",
-    "BenchError",
-    "run_bench",
-    "run_episode",
-]
-
 PLANNERS = ("dwa", "teb")
 LOCALIZATIONS = ("amcl", "ground_truth")
 #: robot -> robot_navigation/param/<set> (navigation_stack.launch's $BASE_TYPE)

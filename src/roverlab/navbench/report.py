@@ -6,7 +6,6 @@ from __future__ import annotations
 import json
 import math
 import os
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -15,6 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 from PIL import Image, ImageDraw
 
+from roverlab.fileio import atomic_write, atomic_write_bytes
 from roverlab.navbench.grid import BenchGrid
 
 if TYPE_CHECKING:
@@ -227,29 +227,11 @@ class BenchReport:
         return {**self.summary(), "records": [r.to_json() for r in self.records]}
 
     def write_json(self, path: Path) -> None:
-        _atomic_write(path, (json.dumps(self.to_dict(), indent=1) + "\n").encode())
+        atomic_write_bytes(path, (json.dumps(self.to_dict(), indent=1) + "\n").encode())
 
     def write_png(self, path: Path) -> None:
         img = draw(self.grid, self.records)
-        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".png")
-        os.close(fd)
-        try:
-            img.save(tmp, format="PNG")
-            os.replace(tmp, path)
-        except BaseException:
-            Path(tmp).unlink(missing_ok=True)
-            raise
-
-
-def _atomic_write(path: Path, data: bytes) -> None:
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.")
-    try:
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+        atomic_write(path, lambda fh: img.save(fh, format="PNG"))
 
 
 _OK_COLOURS = ((31, 119, 180), (44, 160, 44), (148, 103, 189), (23, 190, 207), (140, 86, 75))

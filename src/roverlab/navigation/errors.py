@@ -8,21 +8,6 @@ from __future__ import annotations
 
 from roverlab.errors import RoverlabError
 
-__all__ = [
-    "ControllerError",
-    "CostmapError",
-    "GoalOccupiedError",
-    "GoalOutsideMapBoundsError",
-    "InvalidPathError",
-    "NavigationError",
-    "NavigationParamsError",
-    "NoValidControlError",
-    "NoValidPathCouldBeFoundError",
-    "PlannerError",
-    "StartOccupiedError",
-    "StartOutsideMapBoundsError",
-]
-
 
 class NavigationError(RoverlabError):
     """Base class of every navigation error."""

@@ -25,7 +25,7 @@ from roverlab.raycast.errors import RaycastInputError
 from roverlab.raycast.scene import Scene
 from roverlab.raycast.sweep import SWEEP_MAX_PRIMITIVES_PER_BEAM, fan_step, sweep_fan
 
-__all__ = ["cast_2d", "cast_2d_many", "cast_grid", "cast_grid_many", "grid_ray"]
+__all__ = ["Fan", "cast_2d", "cast_2d_many", "cast_grid", "cast_grid_many", "grid_ray"]
 
 _jit = numba.njit(cache=True, nogil=True)
 
@@ -101,6 +101,8 @@ def _cast_2d_kernel(
     poses: NDArray[np.float64],
     z: float,
     angles: NDArray[np.float64],
+    ca: NDArray[np.float64],
+    sa: NDArray[np.float64],
     rmax: float,
     segs: NDArray[np.float64],
     segz: NDArray[np.float64],
@@ -116,9 +118,9 @@ def _cast_2d_kernel(
     nseg: int,
     out: NDArray[np.float64],
 ) -> None:
+    """Every pose's fan: beam ``i`` along ``angles[i]`` turned by the pose's yaw, whose
+    unit vector at yaw 0 is ``(ca[i], sa[i])``."""
     n = angles.shape[0]
-    ca = np.cos(angles)
-    sa = np.sin(angles)
     # a uniform fan in a small scene: the angular sweep (same ranges, see .sweep)
     step = fan_step(angles)
     sweep = step > 0.0 and segs.shape[0] + circs.shape[0] <= SWEEP_MAX_PRIMITIVES_PER_BEAM * n
@@ -276,18 +278,66 @@ def _range_max(range_max: float) -> float:
     return r
 
 
+@_jit
+def _unit_vectors(angles: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    return np.cos(angles), np.sin(angles)
+
+
 def _run_scene(
-    scene: Scene, poses: NDArray[np.float64], z: float, angles: NDArray[np.float64], rmax: float
+    scene: Scene,
+    poses: NDArray[np.float64],
+    z: float,
+    angles: NDArray[np.float64],
+    rmax: float,
+    unit: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
+    out: NDArray[np.float64] | None = None,
 ) -> NDArray[np.float64]:
     g: Grid = scene_grid(scene)
-    out = np.empty((poses.shape[0], angles.shape[0]), dtype=np.float64)
+    ca, sa = _unit_vectors(angles) if unit is None else unit
+    if out is None:
+        out = np.empty((poses.shape[0], angles.shape[0]), dtype=np.float64)
     _cast_2d_kernel(
-        poses, z, angles, rmax,
+        poses, z, angles, ca, sa, rmax,
         scene.segments, scene.segment_z, scene.circles, scene.circle_z,
         g.x0, g.y0, g.cell, g.nx, g.ny, g.cell_start, g.items, g.n_segments,
         out,
     )  # fmt: skip
     return out
+
+
+class Fan:
+    """One sensor's fan of beams, cast again and again from moving poses (a simulated
+    lidar): the beams' unit vectors are computed once and turned by each pose's yaw,
+    and the arguments are checked once, where :func:`cast_2d` checks them every call.
+
+    Args:
+        rel_angles: (N,) beam angles relative to the sensor's yaw (rad).
+        range_max: maximum range (m).
+
+    Raises:
+        RaycastInputError: non-finite angles, non-positive ``range_max``.
+    """
+
+    def __init__(self, rel_angles: ArrayLike, range_max: float) -> None:
+        self.angles = _angles(rel_angles)
+        self.range_max = _range_max(range_max)
+        self._unit = _unit_vectors(self.angles)
+        self._pose = np.zeros((1, 3))
+        self._out = np.empty((1, self.angles.shape[0]))
+
+    def cast(self, scene: Scene, x: float, y: float, z: float, yaw: float) -> NDArray[np.float64]:
+        """Ranges from ``(x, y)`` at height ``z`` with the sensor turned to ``yaw``, as
+        :func:`cast_2d_many` for one pose. The array is reused by the next call.
+
+        Raises:
+            RaycastInputError: a non-finite pose.
+        """
+        if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z) and math.isfinite(yaw)):
+            raise RaycastInputError(f"lidar pose must be finite, got ({x}, {y}, {z}, {yaw})")
+        pose = self._pose[0]
+        pose[0], pose[1], pose[2] = x, y, yaw
+        _run_scene(scene, self._pose, z, self.angles, self.range_max, self._unit, self._out)
+        return self._out[0]
 
 
 def cast_2d(

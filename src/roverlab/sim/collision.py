@@ -10,7 +10,15 @@ from numpy.typing import NDArray
 
 from roverlab.raycast.scene import Scene
 
-__all__ = ["Obstacles", "circle_polygon", "inner_radius", "polygon_hits"]
+__all__ = [
+    "Obstacles",
+    "any_near",
+    "circle_polygon",
+    "gather_near",
+    "inner_radius",
+    "polygon_hits",
+    "polygon_hits_near",
+]
 
 F64 = NDArray[np.float64]
 
@@ -73,33 +81,146 @@ def _point_segment_dist2(px: float, py: float, ax: float, ay: float, bx: float, 
 
 
 @numba.njit(cache=True, nogil=True)
+def _touches_segment(
+    poly: np.ndarray,
+    box: tuple[float, float, float, float],
+    ax: float,
+    ay: float,
+    bx: float,
+    by: float,
+) -> bool:
+    xmin, ymin, xmax, ymax = box
+    if max(ax, bx) < xmin or min(ax, bx) > xmax or max(ay, by) < ymin or min(ay, by) > ymax:
+        return False
+    if _inside(poly, ax, ay) or _inside(poly, bx, by):
+        return True
+    k = poly.shape[0]
+    for e in range(k):
+        f = (e + 1) % k
+        if _segments_intersect(ax, ay, bx, by, poly[e, 0], poly[e, 1], poly[f, 0], poly[f, 1]):
+            return True
+    return False
+
+
+@numba.njit(cache=True, nogil=True)
+def _touches_circle(
+    poly: np.ndarray, box: tuple[float, float, float, float], cx: float, cy: float, r: float
+) -> bool:
+    xmin, ymin, xmax, ymax = box
+    if cx + r < xmin or cx - r > xmax or cy + r < ymin or cy - r > ymax:
+        return False
+    if _inside(poly, cx, cy):
+        return True
+    r2 = r * r
+    k = poly.shape[0]
+    for e in range(k):
+        f = (e + 1) % k
+        if _point_segment_dist2(cx, cy, poly[e, 0], poly[e, 1], poly[f, 0], poly[f, 1]) < r2:
+            return True
+    return False
+
+
+@numba.njit(cache=True, nogil=True)
+def _bounds(poly: np.ndarray) -> tuple[float, float, float, float]:
+    xmin, ymin = poly[0, 0], poly[0, 1]
+    xmax, ymax = xmin, ymin
+    for i in range(1, poly.shape[0]):
+        x, y = poly[i, 0], poly[i, 1]
+        xmin, xmax = min(xmin, x), max(xmax, x)
+        ymin, ymax = min(ymin, y), max(ymax, y)
+    return xmin, ymin, xmax, ymax
+
+
+@numba.njit(cache=True, nogil=True)
 def polygon_hits(poly: np.ndarray, segments: np.ndarray, circles: np.ndarray) -> bool:
     """True if the closed polygon ``poly`` (K, 2) touches any segment or circle."""
-    k = poly.shape[0]
-    xmin, ymin = poly[:, 0].min(), poly[:, 1].min()
-    xmax, ymax = poly[:, 0].max(), poly[:, 1].max()
+    box = _bounds(poly)
     for i in range(segments.shape[0]):
-        ax, ay, bx, by = segments[i, 0], segments[i, 1], segments[i, 2], segments[i, 3]
-        if max(ax, bx) < xmin or min(ax, bx) > xmax or max(ay, by) < ymin or min(ay, by) > ymax:
-            continue
-        if _inside(poly, ax, ay) or _inside(poly, bx, by):
+        s = segments[i]
+        if _touches_segment(poly, box, s[0], s[1], s[2], s[3]):
             return True
-        for e in range(k):
-            f = (e + 1) % k
-            if _segments_intersect(ax, ay, bx, by, poly[e, 0], poly[e, 1], poly[f, 0], poly[f, 1]):
-                return True
     for i in range(circles.shape[0]):
-        cx, cy, r = circles[i, 0], circles[i, 1], circles[i, 2]
-        if cx + r < xmin or cx - r > xmax or cy + r < ymin or cy - r > ymax:
-            continue
-        if _inside(poly, cx, cy):
+        c = circles[i]
+        if _touches_circle(poly, box, c[0], c[1], c[2]):
             return True
-        r2 = r * r
-        for e in range(k):
-            f = (e + 1) % k
-            if _point_segment_dist2(cx, cy, poly[e, 0], poly[e, 1], poly[f, 0], poly[f, 1]) < r2:
-                return True
     return False
+
+
+@numba.njit(cache=True, nogil=True)
+def polygon_hits_near(
+    poly: np.ndarray,
+    segments: np.ndarray,
+    circles: np.ndarray,
+    near: np.ndarray,
+    n_segments: int,
+    n_circles: int,
+) -> bool:
+    """:func:`polygon_hits` over a subset: ``near[:n_segments]`` index ``segments``, the
+    ``n_circles`` entries after them index ``circles`` (a broad phase's candidates)."""
+    box = _bounds(poly)
+    for j in range(n_segments):
+        s = segments[near[j]]
+        if _touches_segment(poly, box, s[0], s[1], s[2], s[3]):
+            return True
+    for j in range(n_segments, n_segments + n_circles):
+        c = circles[near[j]]
+        if _touches_circle(poly, box, c[0], c[1], c[2]):
+            return True
+    return False
+
+
+@numba.njit(cache=True, nogil=True)
+def any_near(
+    x: float,
+    y: float,
+    radius: float,
+    segments: np.ndarray,
+    circles: np.ndarray,
+    near: np.ndarray,
+    n_segments: int,
+    n_circles: int,
+) -> bool:
+    """Whether any of the candidates (as :func:`polygon_hits_near`) comes within
+    ``radius`` of ``(x, y)``: when none does, a body inside that disc touches nothing."""
+    r2 = radius * radius
+    for j in range(n_segments):
+        s = segments[near[j]]
+        if _point_segment_dist2(x, y, s[0], s[1], s[2], s[3]) <= r2:
+            return True
+    for j in range(n_segments, n_segments + n_circles):
+        c = circles[near[j]]
+        if math.hypot(c[0] - x, c[1] - y) - c[2] <= radius:
+            return True
+    return False
+
+
+@numba.njit(cache=True, nogil=True)
+def gather_near(
+    x: float,
+    y: float,
+    reach: float,
+    segments: np.ndarray,
+    circles: np.ndarray,
+    near: np.ndarray,
+) -> tuple[int, int]:
+    """Write into ``near`` the indices of the segments, then of the circles, that come
+    within ``reach`` of ``(x, y)``; returns how many of each. A body that stays inside
+    the disc of radius ``reach`` around the point can touch no other obstacle."""
+    r2 = reach * reach
+    ns = 0
+    for i in range(segments.shape[0]):
+        s = segments[i]
+        if _point_segment_dist2(x, y, s[0], s[1], s[2], s[3]) <= r2:
+            near[ns] = i
+            ns += 1
+    nc = 0
+    for i in range(circles.shape[0]):
+        c = circles[i]
+        d = math.hypot(c[0] - x, c[1] - y) - c[2]
+        if d <= reach:
+            near[ns + nc] = i
+            nc += 1
+    return ns, nc
 
 
 def circle_polygon(radius: float, sides: int = 24) -> F64:

@@ -8,7 +8,12 @@ physics timer, without a Python callback per step.
 State vector layout (float64, see ``S_*``): ground-truth pose, wheel surface speeds and
 targets, wheel angles, encoder-odometry pose, body twist and forward acceleration, the
 contact flag of the last step and the number of contact events so far (a step in contact
-after one that was not).
+after one that was not), and the broad phase's anchor.
+
+Broad phase: the contact test only looks at the walls and posts within the footprint's
+circumscribed radius plus a margin of an anchor point, gathered again whenever a step
+could leave that disc; the obstacles it skips cannot touch the body, so every result is
+the same as testing them all (60 walls in the maze, a handful near the robot).
 """
 
 from __future__ import annotations
@@ -20,7 +25,7 @@ from typing import Any, TypeVar
 import numba
 import numpy as np
 
-from roverlab.sim.collision import polygon_hits
+from roverlab.sim.collision import any_near, gather_near, polygon_hits_near
 
 F = TypeVar("F", bound=Callable[..., Any])
 
@@ -33,7 +38,11 @@ S_EX, S_EY, S_ETH = 9, 10, 11
 S_V, S_W, S_DV = 12, 13, 14
 S_CONTACT = 15
 S_CONTACTS = 16
-STATE_SIZE = 17
+# broad phase: the obstacles near an anchor point (indices in the ``near`` work array)
+S_AX, S_AY, S_AREACH, S_NSEG, S_NCIRC, S_RADIUS = 17, 18, 19, 20, 21, 22
+STATE_SIZE = 23
+
+BROAD_MARGIN_M = 0.25  # how far the body may move from its anchor before a new gather
 
 P_SEP, P_DIAM, P_ACC, P_SLIP, P_INNER = 0, 1, 2, 3, 4
 
@@ -76,25 +85,66 @@ def _hits(
     segs: np.ndarray,
     circles: np.ndarray,
     buf: np.ndarray,
+    near: np.ndarray,
+    state: np.ndarray,
 ) -> bool:
+    ns, nc = int(state[S_NSEG]), int(state[S_NCIRC])
+    # nothing within the footprint's circumscribed circle (rounding margin): no contact
+    if not any_near(x, y, state[S_RADIUS] + 1e-9, segs, circles, near, ns, nc):
+        return False
     c, s = math.cos(th), math.sin(th)
     for i in range(fp.shape[0]):
         buf[i, 0] = x + c * fp[i, 0] - s * fp[i, 1]
         buf[i, 1] = y + s * fp[i, 0] + c * fp[i, 1]
-    return polygon_hits(buf, segs, circles)
+    return polygon_hits_near(buf, segs, circles, near, ns, nc)
+
+
+@numba.njit(cache=True, nogil=True)
+def _circumradius(fp: np.ndarray) -> float:
+    r = 0.0
+    for i in range(fp.shape[0]):
+        r = max(r, math.hypot(fp[i, 0], fp[i, 1]))
+    return r
+
+
+@numba.njit(cache=True, nogil=True)
+def _cover(
+    state: np.ndarray,
+    x: float,
+    y: float,
+    travel: float,
+    fp: np.ndarray,
+    segs: np.ndarray,
+    circles: np.ndarray,
+    near: np.ndarray,
+) -> None:
+    """Make sure the anchor's gathered obstacles hold every one the body can touch while
+    its origin moves up to ``travel`` from ``(x, y)``; gather anew around ``(x, y)`` if
+    not."""
+    if (
+        state[S_AREACH] > 0.0
+        and math.hypot(x - state[S_AX], y - state[S_AY]) + travel <= (state[S_AREACH])
+    ):
+        return
+    reach = max(BROAD_MARGIN_M, 2.0 * travel)
+    radius = _circumradius(fp)
+    ns, nc = gather_near(x, y, radius + reach + 1e-9, segs, circles, near)
+    state[S_AX], state[S_AY], state[S_AREACH], state[S_RADIUS] = x, y, reach, radius
+    state[S_NSEG], state[S_NCIRC] = ns, nc
 
 
 @numba.njit(cache=True, nogil=True)
 def advance(
     state: np.ndarray,
     params: np.ndarray,
-    steps: int,
     dt: float,
     footprint: np.ndarray,
     segments: np.ndarray,
     circles: np.ndarray,
+    near: np.ndarray,
     noise: np.ndarray,
     noise_pos: int,
+    steps: int,
 ) -> int:
     """Run ``steps`` physics steps of ``dt`` on ``state`` in place.
 
@@ -102,7 +152,8 @@ def advance(
     ``noise_pos`` on (two per step while a wheel turns); returns the new position. A
     motion that would put the footprint into an obstacle stops at the contact (bisection
     of the last clear sub-step) and sets ``state[S_CONTACT]``; a contact after a step
-    without one counts one event in ``state[S_CONTACTS]``.
+    without one counts one event in ``state[S_CONTACTS]``. ``near`` is the broad phase's
+    work array (int64, at least as long as ``segments`` and ``circles`` together).
     """
     sep = params[P_SEP]
     radius = 0.5 * params[P_DIAM]
@@ -143,16 +194,17 @@ def advance(
             if inner > 0.0:
                 n = max(1, int(math.ceil(dist / (0.5 * inner))))
             dth = _wrap(gth - th0)
+            _cover(state, x0, y0, dist, footprint, segments, circles, near)
             px, py = x0, y0
             for k in range(1, n + 1):
                 f = k / n
                 cx = x0 + f * (gx - x0)
                 cy = y0 + f * (gy - y0)
                 cth = _wrap(th0 + f * dth)
-                if _hits(footprint, cx, cy, cth, segments, circles, buf):
+                if _hits(footprint, cx, cy, cth, segments, circles, buf, near, state):
                     contact = True
                     th = cth
-                    if _hits(footprint, px, py, cth, segments, circles, buf):
+                    if _hits(footprint, px, py, cth, segments, circles, buf, near, state):
                         th = th0
                     lo, hi = 0.0, 1.0
                     for _ in range(8):
@@ -165,6 +217,8 @@ def advance(
                             segments,
                             circles,
                             buf,
+                            near,
+                            state,
                         ):
                             hi = mid
                         else:

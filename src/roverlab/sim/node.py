@@ -174,19 +174,22 @@ class SimulatorNode(Node):
             ]
         )
         self._dt = self._step_ns / 1e9
-        self._advance = compiled_entry(
-            advance,
+        obs = self.obstacles
+        self._near = np.zeros(len(obs.segments) + len(obs.circles), dtype=np.int64)
+        # the kernel's arguments that never change, then noise, its position and the steps
+        self._physics_args = (
             self._state,
             self._params,
-            0,
             self._dt,
             self._footprint,
-            self.obstacles.segments,
-            self.obstacles.circles,
-            self._noise,
-            0,
+            obs.segments,
+            obs.circles,
+            self._near,
         )
+        self._advance = compiled_entry(advance, *self._physics_args, self._noise, 0, 0)
         self.tf = TransformBroadcaster(self)
+        self._tf_pub = self.tf.publisher
+        self._wheel_k = 2.0 / self.drive.params.wheel_diameter_m if self.drive else 0.0
         self._mounts: dict[int, tuple[float, float, float, float, float]] = {}
         if self.drive is not None:
             d = self.drive
@@ -253,22 +256,16 @@ class SimulatorNode(Node):
         self._physics_ns += steps * self._step_ns
         if self.drive is None:
             return
-        if self._noise_pos + steps > self._slip_block:
-            self._noise = self._slip_rng.standard_normal((self._slip_block, 2))
-            self._noise_pos = 0
+        if self._noise_pos + steps <= self._slip_block:  # the usual case: one call
+            pos = self._advance(*self._physics_args, self._noise, self._noise_pos, steps)
+            self._noise_pos = pos
+            return
+        self._noise = self._slip_rng.standard_normal((self._slip_block, 2))
+        self._noise_pos = 0
         while steps > 0:
             chunk = min(steps, self._slip_block - self._noise_pos)
-            self._noise_pos = self._advance(
-                self._state,
-                self._params,
-                chunk,
-                self._dt,
-                self._footprint,
-                self.obstacles.segments,
-                self.obstacles.circles,
-                self._noise,
-                self._noise_pos,
-            )
+            pos = self._advance(*self._physics_args, self._noise, self._noise_pos, chunk)
+            self._noise_pos = pos
             steps -= chunk
             if steps > 0:
                 self._noise = self._slip_rng.standard_normal((self._slip_block, 2))
@@ -317,44 +314,52 @@ class SimulatorNode(Node):
         d = self.drive
         assert d is not None
         ns = self._executor.now_ns  # a timer callback: the event's time
-        x, y, yaw = self.odometry_pose()
+        if ns >= self._physics_ns + self._step_ns:
+            self.advance()
         st = self._state.tolist()
         if d.odometry_source == "encoder":
+            x, y, yaw = st[S_EX], st[S_EY], st[S_ETH]
             v = 0.5 * (st[S_VL] + st[S_VR])
             w = (st[S_VR] - st[S_VL]) / d.params.wheel_separation_m
         else:
+            x, y, yaw = st[S_X], st[S_Y], st[S_TH]
             v, w = st[S_V], st[S_W]
         sec, nsec = divmod(ns, 1_000_000_000)
         half = 0.5 * yaw
         qz, qw = math.sin(half), math.cos(half)
+        time, header, vec, quat = mc.Time, mc.Header, mc.Vector3, mc.Quaternion
         self.odom_pub.publish(
             mc.Odometry(
-                mc.Header(mc.Time(sec, nsec), d.odometry_frame),
+                header(time(sec, nsec), d.odometry_frame),
                 d.robot_base_frame,
                 mc.PoseWithCovariance(
-                    mc.Pose(mc.Point(x, y, 0.0), mc.Quaternion(0.0, 0.0, qz, qw)), self._pose_cov
+                    mc.Pose(mc.Point(x, y, 0.0), quat(0.0, 0.0, qz, qw)), self._pose_cov
                 ),
                 mc.TwistWithCovariance(
-                    mc.Twist(mc.Vector3(v, 0.0, 0.0), mc.Vector3(0.0, 0.0, w)), self._twist_cov
+                    mc.Twist(vec(v, 0.0, 0.0), vec(0.0, 0.0, w)), self._twist_cov
                 ),
             )
         )
-        if d.publish_odom_tf:
-            self.tf.send_transform(
-                mc.TransformStamped(
-                    mc.Header(mc.Time(sec, nsec), d.odometry_frame),
-                    d.robot_base_frame,
-                    mc.Transform(mc.Vector3(x, y, 0.0), mc.Quaternion(0.0, 0.0, qz, qw)),
+        # the transform is built only when someone reads /tf (here or in another process)
+        if d.publish_odom_tf and self._tf_pub.has_listeners:
+            self._tf_pub.publish(
+                mc.TFMessage(
+                    [
+                        mc.TransformStamped(
+                            header(time(sec, nsec), d.odometry_frame),
+                            d.robot_base_frame,
+                            mc.Transform(vec(x, y, 0.0), quat(0.0, 0.0, qz, qw)),
+                        )
+                    ]
                 )
             )
         if self.joint_pub is not None:
-            # one buffer for position, velocity and effort (each message its own)
-            k = 2.0 / d.params.wheel_diameter_m
-            values = np.array([st[S_AL], st[S_AR], st[S_VL], st[S_VR], 0.0, 0.0])
-            values[2:4] *= k
+            # one buffer for position, velocity (wheel surface speed / radius) and effort
+            k = self._wheel_k
+            values = np.array((st[S_AL], st[S_AR], st[S_VL] * k, st[S_VR] * k, 0.0, 0.0))
             self.joint_pub.publish(
                 mc.JointState(
-                    mc.Header(mc.Time(sec, nsec), ""),
+                    header(time(sec, nsec), ""),
                     [d.left_joint, d.right_joint],
                     values[0:2],
                     values[2:4],
@@ -434,19 +439,40 @@ class SimulatorNode(Node):
         ex = self._executor
         frame = sensor.frame_id
         state = self._state  # updated in place, never replaced
-        measure = model.measure
+        rows = model.noise_rows()
+        advance, nxt, sin, cos = self.advance, next, math.sin, math.cos
+        physics, physics_args, slip_block = self._advance, self._physics_args, self._slip_block
+        driven = self.drive is not None
         publish = pub.publish
         imu, header, stamp, quat, vec = mc.Imu, mc.Header, mc.Time, mc.Quaternion, mc.Vector3
 
+        step_ns = self._step_ns
+
         def tick() -> None:
-            # runs at the physics rate: names bound once, the header built inline
-            if ex.now_ns >= self._physics_ns + self._step_ns:
-                self.advance()
+            # runs at the physics rate: ImuModel.measure and the usual one-step advance()
+            # inlined, names bound once
+            now = ex.now_ns
+            if now >= self._physics_ns + step_ns:
+                if driven and now < self._physics_ns + 2 * step_ns and self._noise_pos < slip_block:
+                    self._physics_ns += step_ns
+                    self._noise_pos = physics(*physics_args, self._noise, self._noise_pos, 1)
+                else:
+                    advance()
             st = state.tolist()
-            q, gyro, acc = measure(st[S_TH], st[S_V], st[S_W], st[S_DV])
-            sec, nsec = divmod(ex.now_ns, 1_000_000_000)
+            v, w = st[S_V], st[S_W]
+            n = nxt(rows)
+            half = 0.5 * st[S_TH]
+            sec, nsec = divmod(now, 1_000_000_000)
             publish(
-                imu(header(stamp(sec, nsec), frame), quat(*q), cov, vec(*gyro), cov, vec(*acc), cov)
+                imu(
+                    header(stamp(sec, nsec), frame),
+                    quat(0.0, 0.0, sin(half), cos(half)),
+                    cov,
+                    vec(n[0], n[1], w + n[2]),
+                    cov,
+                    vec(st[S_DV] + n[3], v * w + n[4], n[5]),
+                    cov,
+                )
             )
 
         self.create_timer(1.0 / rate, tick)

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 import sys
+from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Any
 
@@ -18,7 +19,7 @@ from numpy.typing import NDArray
 
 from roverlab.raycast import Scene
 from roverlab.raycast.camera import render, render_rgb
-from roverlab.raycast.lidar import cast_2d
+from roverlab.raycast.lidar import Fan
 
 __all__ = ["CameraModel", "ImuModel", "ImuNoise", "LidarModel", "LidarParams"]
 
@@ -76,7 +77,7 @@ class LidarModel:
     def __init__(self, params: LidarParams, rng: np.random.Generator) -> None:
         self.params = params
         self.rng = rng
-        self._rel = params.angles()
+        self._fan = Fan(params.angles(), params.range_max)
         # noise rows drawn _SCAN_BLOCK scans at a time: the same numbers, in the same
         # order, as one draw per scan (the generator serves nobody else)
         self._noise: F64 = np.full((1, params.samples), params.noise_mean)
@@ -95,7 +96,7 @@ class LidarModel:
 
     def scan(self, scene: Scene, x: float, y: float, z: float, yaw: float) -> NDArray[np.float32]:
         p = self.params
-        ranges = cast_2d(scene, x, y, z, self._rel + yaw, p.range_max)
+        ranges = self._fan.cast(scene, x, y, z, yaw)
         return _finish_scan(ranges, self._noise_row(), p.range_min, p.range_max, p.range_resolution)
 
 
@@ -169,24 +170,36 @@ class ImuModel:
         sign = np.where(self.rng.random(3) < 0.5, -1.0, 1.0)
         return mag * sign
 
-    def _noise_row(self) -> list[float]:
-        """Bias + noise of one measurement: gyro x, y, z, accel x, y, z (gravity on z).
+    def _refill(self) -> None:
+        """Bias + noise of the next measurements: gyro x, y, z, accel x, y, z (gravity on
+        z). Drawn in blocks of 12 standard normals per measurement (6 for the ``<noise>``
+        stddevs, 6 for ``gaussianNoise``) and combined with numpy, once per block."""
+        z = self.rng.standard_normal((_BLOCK, 12))
+        rn, an, g = self.rate_noise, self.accel_noise, self.gaussian_noise
+        rows = np.empty((_BLOCK, 6))
+        rows[:, :3] = (self.rate_bias + rn.mean) + rn.stddev * z[:, 0:3] + g * z[:, 6:9]
+        rows[:, 3:] = (self.accel_bias + an.mean) + an.stddev * z[:, 3:6] + g * z[:, 9:12]
+        rows[:, 5] += GRAVITY
+        self._block = rows.tolist()
+        self._pos = 0
 
-        Drawn in blocks of 12 standard normals per measurement (6 for the ``<noise>``
-        stddevs, 6 for ``gaussianNoise``) and combined with numpy, once per block.
-        """
+    def _noise_row(self) -> list[float]:
         if self._pos >= len(self._block):
-            z = self.rng.standard_normal((_BLOCK, 12))
-            rn, an, g = self.rate_noise, self.accel_noise, self.gaussian_noise
-            rows = np.empty((_BLOCK, 6))
-            rows[:, :3] = (self.rate_bias + rn.mean) + rn.stddev * z[:, 0:3] + g * z[:, 6:9]
-            rows[:, 3:] = (self.accel_bias + an.mean) + an.stddev * z[:, 3:6] + g * z[:, 9:12]
-            rows[:, 5] += GRAVITY
-            self._block = rows.tolist()
-            self._pos = 0
+            self._refill()
         row = self._block[self._pos]
         self._pos += 1
         return row
+
+    def noise_rows(self) -> Iterator[list[float]]:
+        """The noise rows :meth:`measure` would use, in the same order (it and this
+        iterator share one position): for a caller that applies them itself."""
+        while True:
+            pos = self._pos
+            if pos >= len(self._block):
+                self._refill()
+                pos = 0
+            self._pos = pos + 1
+            yield self._block[pos]
 
     def measure(
         self, yaw: float, v: float, w: float, dv_dt: float

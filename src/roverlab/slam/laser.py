@@ -11,7 +11,7 @@ from numpy.typing import NDArray
 from roverlab.geometry import SE2, Transform3, quat_rotate
 from roverlab.msgs import scan_angles
 
-__all__ = ["LaserGeometry", "laser_geometry"]
+__all__ = ["LaserGeometry", "beam_endpoints", "laser_geometry"]
 
 
 @dataclasses.dataclass(frozen=True, slots=True)
@@ -53,4 +53,15 @@ def laser_geometry(scan: Any, base_T_laser: Transform3) -> LaserGeometry:
         angles=np.arctan2(dy, dx),
         z_m=float(tz),
         upside_down=bool(ez[2] < 0.0),
+    )
+
+
+def beam_endpoints(
+    ranges: NDArray[np.float64], angles: NDArray[np.float64], laser_offset: SE2
+) -> NDArray[np.float64]:
+    """``(N, 2)`` end points in the robot frame of beams of ``ranges`` at ``angles`` (laser
+    frame) from a laser at ``laser_offset``."""
+    ang = angles + laser_offset.theta
+    return np.stack(
+        [laser_offset.x + ranges * np.cos(ang), laser_offset.y + ranges * np.sin(ang)], axis=1
     )

@@ -36,23 +36,6 @@ from typing import Final, Protocol
 
 from roverlab.teleop.errors import TeleopError
 
-__all__ = [
-    "CTRL_C",
-    "HELP_TEXT",
-    "MOVE_BINDINGS",
-    "SMOOTH_HELP_TEXT",
-    "SMOOTH_MOVE_BINDINGS",
-    "SPEED_BINDINGS",
-    "KeyResult",
-    "SmoothTeleop",
-    "TeleopLogic",
-    "TeleopTwistKeyboard",
-    "TwistCommand",
-    "check_speed",
-    "twist_for_key",
-    "vels",
-]
-
 CTRL_C: Final = "\x03"
 
 HELP_TEXT: Final = """
@@ -247,7 +230,50 @@ def twist_for_key(key: str, speed: float, turn: float) -> TwistCommand | None:
     return STOP
 
 
-class TeleopTwistKeyboard:
+class _KeyboardSpeeds:
+    """What both keyboard loops keep: the speed and turn the speed keys scale, and a count of
+    speed changes (the help is reprinted every 15th).
+
+    Raises:
+        TeleopError: ``speed`` or ``turn`` is not a finite number >= 0.
+    """
+
+    help_text: str = HELP_TEXT
+
+    def __init__(self, speed: float, turn: float) -> None:
+        self._speed = check_speed("speed", speed)
+        self._turn = check_speed("turn", turn)
+        self._status = 0
+
+    @property
+    def speed(self) -> float:
+        return self._speed
+
+    @property
+    def turn(self) -> float:
+        return self._turn
+
+    @property
+    def status(self) -> int:
+        """Speed changes so far, modulo 15 (the help is reprinted when it wraps)."""
+        return self._status
+
+    def banner(self) -> tuple[str, ...]:
+        return (self.help_text, vels(self._speed, self._turn))
+
+    def _change_speed(self, key: str) -> list[str]:
+        """Apply speed key ``key``: the new ``vels`` line, and the help when it is due."""
+        speed_factor, turn_factor = SPEED_BINDINGS[key]
+        self._speed = _scaled(self._speed, speed_factor)
+        self._turn = _scaled(self._turn, turn_factor)
+        lines = [vels(self._speed, self._turn)]
+        if self._status == _HELP_EVERY - 1:
+            lines.append(self.help_text)
+        self._status = (self._status + 1) % _HELP_EVERY
+        return lines
+
+
+class TeleopTwistKeyboard(_KeyboardSpeeds):
     """teleop_twist_keyboard.py's loop body, one key at a time.
 
     Args:
@@ -262,31 +288,13 @@ class TeleopTwistKeyboard:
     help_text: str = HELP_TEXT
 
     def __init__(self, *, speed: float = 0.3, turn: float = 0.5) -> None:
-        self._speed = check_speed("speed", speed)
-        self._turn = check_speed("turn", turn)
+        super().__init__(speed, turn)
         self._direction: tuple[int, int, int, int] = (0, 0, 0, 0)
-        self._status = 0
-
-    @property
-    def speed(self) -> float:
-        return self._speed
-
-    @property
-    def turn(self) -> float:
-        return self._turn
 
     @property
     def direction(self) -> tuple[int, int, int, int]:
         """The last movement key's (x, y, z, th), zeros after a stop."""
         return self._direction
-
-    @property
-    def status(self) -> int:
-        """Speed changes so far, modulo 15 (the help is reprinted when it wraps)."""
-        return self._status
-
-    def banner(self) -> tuple[str, ...]:
-        return (self.help_text, vels(self._speed, self._turn))
 
     def command(self) -> TwistCommand:
         """The velocity for the current direction, speed and turn."""
@@ -305,18 +313,8 @@ class TeleopTwistKeyboard:
                 return KeyResult(None, quit=True)
         return KeyResult(self.command(), lines=tuple(lines))
 
-    def _change_speed(self, key: str) -> list[str]:
-        speed_factor, turn_factor = SPEED_BINDINGS[key]
-        self._speed = _scaled(self._speed, speed_factor)
-        self._turn = _scaled(self._turn, turn_factor)
-        lines = [vels(self._speed, self._turn)]
-        if self._status == _HELP_EVERY - 1:
-            lines.append(self.help_text)
-        self._status = (self._status + 1) % _HELP_EVERY
-        return lines
 
-
-class SmoothTeleop:
+class SmoothTeleop(_KeyboardSpeeds):
     """mbot_teleop.py's loop body: ramped velocities, one step per key or 0.1 s wait.
 
     Args:
@@ -342,8 +340,7 @@ class SmoothTeleop:
         angular_step: float = 0.1,
         idle_steps: int = 5,
     ) -> None:
-        self._speed = check_speed("speed", speed)
-        self._turn = check_speed("turn", turn)
+        super().__init__(speed, turn)
         self.linear_step = check_speed("linear_step", linear_step)
         self.angular_step = check_speed("angular_step", angular_step)
         if isinstance(idle_steps, bool) or not isinstance(idle_steps, int) or idle_steps < 1:
@@ -351,30 +348,14 @@ class SmoothTeleop:
         self.idle_steps = idle_steps
         self._x = 0
         self._th = 0
-        self._status = 0
         self._count = 0
         self._control_speed: float = 0.0
         self._control_turn: float = 0.0
 
     @property
-    def speed(self) -> float:
-        return self._speed
-
-    @property
-    def turn(self) -> float:
-        return self._turn
-
-    @property
-    def status(self) -> int:
-        return self._status
-
-    @property
     def idle_count(self) -> int:
         """Steps since the last movement or speed key."""
         return self._count
-
-    def banner(self) -> tuple[str, ...]:
-        return (self.help_text, vels(self._speed, self._turn))
 
     def command(self) -> TwistCommand:
         """The ramped velocity of the last step."""
@@ -386,14 +367,8 @@ class SmoothTeleop:
             self._x, self._th = SMOOTH_MOVE_BINDINGS[key]
             self._count = 0
         elif key in SPEED_BINDINGS:
-            speed_factor, turn_factor = SPEED_BINDINGS[key]
-            self._speed = _scaled(self._speed, speed_factor)
-            self._turn = _scaled(self._turn, turn_factor)
+            lines.extend(self._change_speed(key))
             self._count = 0
-            lines.append(vels(self._speed, self._turn))
-            if self._status == _HELP_EVERY - 1:
-                lines.append(self.help_text)
-            self._status = (self._status + 1) % _HELP_EVERY
         elif key in (" ", "k"):
             self._x = self._th = 0
             self._control_speed = self._control_turn = 0.0

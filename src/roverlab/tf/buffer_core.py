@@ -16,6 +16,7 @@ the latest time at which every edge of the chain has data.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 from typing import Final
 
 from roverlab.core.time import Duration, Time
@@ -490,46 +491,25 @@ class BufferCore:
     def _latest_common_time(self, target: str, source: str) -> int:
         """tf2's getLatestCommonTime: the oldest of the newest stamps of the dynamic edges
         between the two frames (0 if all static)."""
-        caches = self._caches
         chain: list[tuple[int, str]] = []  # (latest stamp, parent) from the source up
         common = _MAX_NS
-        frame = source
-        for _ in range(MAX_GRAPH_DEPTH + 1):
-            cache = caches.get(frame)
-            if cache is None:
-                break
-            stamp, parent = cache.latest()
-            if parent is None:
-                break
+        for stamp, parent in self._latest_edges(source):
             if stamp:
                 common = min(common, stamp)
             chain.append((stamp, parent))
-            frame = parent
-            if frame == target:
+            if parent == target:
                 return 0 if common == _MAX_NS else common
-        else:
-            raise self._loop_error()
         source_ancestors = {parent for _, parent in chain}
         common = _MAX_NS
         common_parent: str | None = None
-        frame = target
-        for _ in range(MAX_GRAPH_DEPTH + 1):
-            cache = caches.get(frame)
-            if cache is None:
-                break
-            stamp, parent = cache.latest()
-            if parent is None:
-                break
+        for stamp, parent in self._latest_edges(target):
             if stamp:
                 common = min(common, stamp)
             if parent in source_ancestors:
                 common_parent = parent
                 break
-            frame = parent
-            if frame == source:
+            if parent == source:
                 return 0 if common == _MAX_NS else common
-        else:
-            raise self._loop_error()
         if common_parent is None:
             raise self._connectivity_error(source, target)
         for stamp, parent in chain:
@@ -538,6 +518,24 @@ class BufferCore:
             if parent == common_parent:
                 break
         return 0 if common == _MAX_NS else common
+
+    def _latest_edges(self, frame: str) -> Iterator[tuple[int, str]]:
+        """``(newest stamp, parent)`` of each edge from ``frame`` up to its root.
+
+        Raises:
+            LookupException: more than :data:`MAX_GRAPH_DEPTH` edges (a loop).
+        """
+        caches = self._caches
+        for _ in range(MAX_GRAPH_DEPTH + 1):
+            cache = caches.get(frame)
+            if cache is None:
+                return
+            stamp, parent = cache.latest()
+            if parent is None:
+                return
+            yield stamp, parent
+            frame = parent
+        raise self._loop_error()
 
     @staticmethod
     def _suffix(source: str, target: str) -> str:

@@ -8,18 +8,6 @@ from __future__ import annotations
 
 from roverlab.errors import RoverlabError
 
-__all__ = [
-    "BackwardExtrapolationException",
-    "ConnectivityException",
-    "ExtrapolationException",
-    "ForwardExtrapolationException",
-    "InvalidArgumentException",
-    "LookupException",
-    "NoDataForExtrapolationException",
-    "TimeoutException",
-    "TransformException",
-]
-
 
 class TransformException(RoverlabError):  # noqa: N818 (tf2 names)
     """Base class of every tf error."""

@@ -61,6 +61,11 @@ class TransformBroadcaster:
     def __init__(self, node: NodeLike, qos: QoSProfile | int = 100) -> None:
         self._pub = node.create_publisher(TF_MESSAGE_TYPE, TF_TOPIC, qos)
 
+    @property
+    def publisher(self) -> Any:
+        """The ``/tf`` publisher (for a caller that builds the TFMessage itself)."""
+        return self._pub
+
     def send_transform(self, transform: Any | Sequence[Any]) -> None:
         """Publish one TransformStamped, or a list of them in one TFMessage."""
         self._pub.publish(tf_message(_as_list(transform)))

@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import json
 import os
-import tempfile
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -28,6 +27,7 @@ from typing import Any, Final
 import yaml
 
 from roverlab.errors import yaml_reason
+from roverlab.fileio import atomic_write_text
 from roverlab.viz.errors import DashboardError
 from roverlab.viz.kinds import DISPLAY_KINDS, RVIZ_CLASSES, DisplayKind
 from roverlab.viz.views import check_view, default_view, view_from_rviz
@@ -480,14 +480,7 @@ def save_config(config: DashboardConfig, path: str | os.PathLike[str]) -> Path:
     text = json.dumps(config.to_dict(), indent=2) + "\n"
     try:
         p.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", dir=p.parent)
+        atomic_write_text(p, text)
     except OSError as err:
-        raise ConfigError(f"{p}: cannot write: {err}") from err
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-        os.replace(tmp, p)
-    except OSError as err:
-        Path(tmp).unlink(missing_ok=True)
         raise ConfigError(f"{p}: cannot write: {err}") from err
     return p

@@ -111,14 +111,7 @@ def start_rviz(
         config = default_config(parsed.fixed_frame or "map")
     elif parsed.fixed_frame:
         config.fixed_frame = parsed.fixed_frame
-    host = os.environ.get("ROVERLAB_DASHBOARD_HOST", "127.0.0.1")
-    text = os.environ.get("ROVERLAB_DASHBOARD_PORT", str(DEFAULT_PORT))
-    try:
-        port = int(text)
-    except ValueError:
-        raise DashboardError(
-            f"ROVERLAB_DASHBOARD_PORT must be a port number, got {text!r}"
-        ) from None
+    host, port = _dashboard_address()
     server = DashboardServer(context, host, port, config=config, node_name=node_name)
     try:
         server.start()
@@ -128,6 +121,23 @@ def start_rviz(
         return None
     server.bridge.node.get_logger().info(f"rviz: the web dashboard is at {server.url}")
     return server.bridge.node
+
+
+def _dashboard_address() -> tuple[str, int]:
+    """``$ROVERLAB_DASHBOARD_HOST`` (default 127.0.0.1) and ``$ROVERLAB_DASHBOARD_PORT``.
+
+    Raises:
+        DashboardError: the port is not a number.
+    """
+    host = os.environ.get("ROVERLAB_DASHBOARD_HOST", "127.0.0.1")
+    text = os.environ.get("ROVERLAB_DASHBOARD_PORT", str(DEFAULT_PORT))
+    try:
+        port = int(text)
+    except ValueError:
+        raise DashboardError(
+            f"ROVERLAB_DASHBOARD_PORT must be a port number, got {text!r}"
+        ) from None
+    return host, port
 
 
 def image_view_config(topic: str | None) -> DashboardConfig:
@@ -164,14 +174,7 @@ def start_image_view(
     where = f"{source}: " if source else ""
     positional = [a for a in shlex.split(args) if not a.startswith("-")]
     topic = positional[0] if positional else remaps.get("image") or remaps.get("/image")
-    host = os.environ.get("ROVERLAB_DASHBOARD_HOST", "127.0.0.1")
-    text = os.environ.get("ROVERLAB_DASHBOARD_PORT", str(DEFAULT_PORT))
-    try:
-        port = int(text)
-    except ValueError:
-        raise DashboardError(
-            f"ROVERLAB_DASHBOARD_PORT must be a port number, got {text!r}"
-        ) from None
+    host, port = _dashboard_address()
     for attempt in (port, 0):
         server = DashboardServer(
             context, host, attempt, config=image_view_config(topic), node_name=node_name

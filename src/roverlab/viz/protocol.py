@@ -30,7 +30,7 @@ from __future__ import annotations
 import io
 import math
 import struct
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from typing import Any, Final
 
@@ -397,16 +397,22 @@ def _shape_points(geometry: object) -> NDArray[np.float64] | None:
 def robot_outlines(model: RobotModel) -> list[VisualOutline]:
     """The top-view outline of every box, cylinder and sphere visual of ``model``."""
     out: list[VisualOutline] = []
+    for link_name, visual, rgba in _visuals(model):
+        pts = _shape_points(visual.geometry)
+        if pts is not None:
+            out.append(VisualOutline(link_name, visual.origin.apply(pts), rgba))
+    return out
+
+
+def _visuals(model: RobotModel) -> Iterator[tuple[str, Any, tuple[float, float, float, float]]]:
+    """``(link name, visual, rgba)`` of every visual of ``model``; grey where the URDF
+    material gives no colour."""
     for link in model.links.values():
         for visual in link.visuals:
-            pts = _shape_points(visual.geometry)
-            if pts is None:
-                continue
             rgba = (0.6, 0.6, 0.6, 1.0)
             if visual.material is not None and visual.material.rgba is not None:
                 rgba = tuple(float(c) for c in visual.material.rgba)  # type: ignore[assignment]
-            out.append(VisualOutline(link.name, visual.origin.apply(pts), rgba))
-    return out
+            yield link.name, visual, rgba
 
 
 @dataclass(frozen=True)
@@ -455,15 +461,10 @@ def _geometry_dict(geometry: object) -> dict[str, Any] | None:
 def robot_shapes(model: RobotModel) -> list[VisualShape]:
     """Every visual of ``model`` as a :class:`VisualShape` (rviz's RobotModel display)."""
     out: list[VisualShape] = []
-    for link in model.links.values():
-        for visual in link.visuals:
-            geometry = _geometry_dict(visual.geometry)
-            if geometry is None:
-                continue
-            rgba = (0.6, 0.6, 0.6, 1.0)
-            if visual.material is not None and visual.material.rgba is not None:
-                rgba = tuple(float(c) for c in visual.material.rgba)  # type: ignore[assignment]
+    for link_name, visual, rgba in _visuals(model):
+        geometry = _geometry_dict(visual.geometry)
+        if geometry is not None:
             o = visual.origin
             origin = [round(float(v), 6) for v in (*o.translation, *o.rotation)]
-            out.append(VisualShape(link.name, geometry, origin, rgba))
+            out.append(VisualShape(link_name, geometry, origin, rgba))
     return out

@@ -29,6 +29,7 @@ from roverlab.msgs import (
 )
 from roverlab.msgs import classes as mc
 from roverlab.tf import StaticTransformBroadcaster, TransformBroadcaster, transform_to_msg
+from tests.helpers.nodes import collect
 from tests.localization.amcl.helpers import BEARINGS, ORIGIN, RES, room_grid, scan_at
 
 START = SE2(2.0, 1.5, 0.3)  # the robot in the map frame
@@ -86,14 +87,6 @@ def _map_file(tmp_path: Path, data: np.ndarray | None = None) -> Path:
     return saved.yaml_path
 
 
-def _collect(ctx: Context, topics: dict[str, Any]) -> dict[str, list[Any]]:
-    got: dict[str, list[Any]] = {t: [] for t in topics}
-    node = ctx.create_node("collector")
-    for topic, typ in topics.items():
-        node.create_subscription(typ, topic, got[topic].append, QoSProfile(depth=1000))
-    return got
-
-
 def _estimate(node: AmclNode, robot: FakeRobot) -> SE2:
     assert node.map_to_odom is not None
     return node.map_to_odom.to_se2() * robot.odom
@@ -123,7 +116,7 @@ def test_localises_and_publishes_pose_cloud_and_tf(tmp_path: Path) -> None:
     MapServer(ctx, yaml_path=_map_file(tmp_path))
     robot = FakeRobot(ctx)
     node = AmclNode(ctx, parameter_overrides={**START_PARAMS, "initial_pose_x": 2.2})
-    got = _collect(ctx, {"/amcl_pose": mc.PoseWithCovarianceStamped,
+    got = collect(ctx, {"/amcl_pose": mc.PoseWithCovarianceStamped,
                          "/particlecloud": mc.PoseArray, "/tf": mc.TFMessage})  # fmt: skip
     for k in range(40):  # drive 2 m back and forth along x
         robot.truth = SE2(START.x + 1.0 - abs(1.0 - 0.05 * (k % 40)), START.y, START.theta)
@@ -302,7 +295,7 @@ def test_upside_down_laser_and_saved_pose(tmp_path: Path) -> None:
     robot = FakeRobot(ctx, upside_down=True)
     node = AmclNode(ctx, parameter_overrides={**START_PARAMS, "save_pose_rate": 2.0,
                                               "gui_publish_rate": 1.0})  # fmt: skip
-    got = _collect(ctx, {"/particlecloud": mc.PoseArray})
+    got = collect(ctx, {"/particlecloud": mc.PoseArray})
     for k in range(20):
         robot.truth = SE2(START.x + 0.1 * k, START.y, START.theta)
         ctx.spin_for(0.25)
@@ -358,7 +351,7 @@ def test_seeded_node_runs_repeat(tmp_path: Path) -> None:
         MapServer(ctx, yaml_path=_map_file(tmp_path))
         robot = FakeRobot(ctx)
         node = AmclNode(ctx, parameter_overrides={**START_PARAMS, "seed": seed})
-        got = _collect(ctx, {"/amcl_pose": mc.PoseWithCovarianceStamped})
+        got = collect(ctx, {"/amcl_pose": mc.PoseWithCovarianceStamped})
         for k in range(10):
             robot.truth = SE2(START.x + 0.1 * k, START.y, START.theta)
             ctx.spin_for(0.25)

@@ -12,7 +12,6 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from roverlab.cli.main import main
 from roverlab.navbench import (
     TIMING_KEYS,
     BenchConfig,
@@ -24,6 +23,7 @@ from roverlab.navbench import (
     run_episode,
     sample_goals,
 )
+from tests.helpers.nodes import run_main
 
 RES = 0.05
 
@@ -35,14 +35,6 @@ def _room(wall_gap: bool = True) -> BenchGrid:
     costs[0, :] = costs[-1, :] = costs[:, 0] = costs[:, -1] = 254
     costs[: 40 if wall_gap else 60, 40] = 254
     return BenchGrid(costs, RES, (0.0, 0.0))
-
-
-def _main(argv: list[str]) -> int:
-    try:
-        main(argv)
-    except SystemExit as done:
-        return int(done.code or 0)
-    return 0
 
 
 def test_shortest_path_goes_around_the_wall_by_line_of_sight() -> None:
@@ -140,7 +132,7 @@ def test_report_figures_json_and_picture(tmp_path: Path) -> None:
 def test_bad_input_is_one_line_exit_2(
     tmp_path: Path, args: list[str], message: str, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    assert _main(["nav", "bench", "--out", str(tmp_path / "out"), *args]) == 2
+    assert run_main(["nav", "bench", "--out", str(tmp_path / "out"), *args]) == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith(message) and "\n" not in err
 

@@ -15,7 +15,6 @@ The layout ``cameracalibrator.py`` writes (``ost.yaml``)::
 from __future__ import annotations
 
 import os
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -24,6 +23,7 @@ import numpy as np
 import yaml
 
 from roverlab.drivers.errors import DriverError
+from roverlab.fileio import atomic_write_text
 
 __all__ = ["CameraCalibration", "load_calibration", "save_calibration"]
 
@@ -119,11 +119,4 @@ def save_calibration(calibration: CameraCalibration, path: str | os.PathLike[str
     """Write a calibration YAML file (atomically: a temporary file renamed into place)."""
     p = Path(path)
     text = yaml.safe_dump(calibration.to_dict(), sort_keys=False, default_flow_style=None)
-    fd, tmp = tempfile.mkstemp(dir=p.parent, prefix=f".{p.name}.")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
-        os.replace(tmp, p)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    atomic_write_text(p, text)

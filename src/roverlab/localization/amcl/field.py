@@ -22,6 +22,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy import ndimage
 
 from roverlab.localization.amcl.errors import AmclMapError
+from roverlab.maps.map_io import GridShape
 
 __all__ = ["FREE", "OCCUPIED", "AmclMap"]
 
@@ -34,7 +35,7 @@ FloatArray = NDArray[np.float64]
 
 
 @dataclass(frozen=True, eq=False, kw_only=True)
-class AmclMap:
+class AmclMap(GridShape):
     """A map for amcl, validated, with its likelihood field.
 
     Args:
@@ -102,14 +103,6 @@ class AmclMap:
         object.__setattr__(self, "distance", dist)
         object.__setattr__(self, "free_cells", free)
         object.__setattr__(self, "blocked", blocked)
-
-    @property
-    def width(self) -> int:
-        return int(self.data.shape[1])
-
-    @property
-    def height(self) -> int:
-        return int(self.data.shape[0])
 
     @property
     def bounds(self) -> tuple[float, float, float, float]:

@@ -20,6 +20,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, Final
 
+from roverlab.core.rosparams import FieldKinds
 from roverlab.localization.amcl.errors import AmclParamsError
 
 __all__ = [
@@ -70,12 +71,14 @@ NODE_PARAMETERS: Final = frozenset(
 #: ``--run-from-bag`` mode, which ``roverlab amcl run`` replaces.)
 IGNORED_PARAMETERS: Final = frozenset({"restore_defaults", "bag_scan_period"})
 
-_INT_FIELDS = frozenset({"min_particles", "max_particles", "resample_interval", "laser_max_beams"})
-_BOOL_FIELDS = frozenset(
-    {"use_map_topic", "first_map_only", "selective_resampling", "tf_broadcast", "do_beamskip"}
-)
-_STR_FIELDS = frozenset(
-    {"laser_model_type", "odom_model_type", "odom_frame_id", "base_frame_id", "global_frame_id"}
+_KINDS = FieldKinds(
+    ints=frozenset({"min_particles", "max_particles", "resample_interval", "laser_max_beams"}),
+    bools=frozenset(
+        {"use_map_topic", "first_map_only", "selective_resampling", "tf_broadcast", "do_beamskip"}
+    ),
+    strs=frozenset(
+        {"laser_model_type", "odom_model_type", "odom_frame_id", "base_frame_id", "global_frame_id"}
+    ),
 )
 # a typo must not allocate gigabytes
 _MAX_PARTICLES = 1_000_000
@@ -196,8 +199,7 @@ class AmclParams:
     global_frame_id: str = "map"
 
     def __post_init__(self) -> None:
-        for f in dataclasses.fields(self):
-            _check_type(f.name, getattr(self, f.name))
+        _KINDS.check(self, AmclParamsError)
         _check(self.min_particles >= 1, "min_particles must be >= 1")
         _check(
             self.min_particles <= self.max_particles <= _MAX_PARTICLES,
@@ -254,22 +256,13 @@ class AmclParams:
             AmclParamsError: an unknown name or a bad value.
         """
         names = [f.name for f in dataclasses.fields(cls)]
-        kwargs: dict[str, Any] = {}
-        for key, value in params.items():
-            if key in IGNORED_PARAMETERS:
-                continue
-            if key not in names:
-                near = difflib.get_close_matches(key, names, n=1)
-                hint = f" (did you mean {near[0]!r}?)" if near else ""
-                raise AmclParamsError(f"unknown amcl parameter {key!r}{hint}")
-            if isinstance(value, bool) or key in _STR_FIELDS or key in _BOOL_FIELDS:
-                kwargs[key] = value
-            elif key in _INT_FIELDS and isinstance(value, float) and value.is_integer():
-                kwargs[key] = int(value)
-            elif key not in _INT_FIELDS and isinstance(value, int):
-                kwargs[key] = float(value)
-            else:
-                kwargs[key] = value
+
+        def unknown(key: str) -> AmclParamsError:
+            near = difflib.get_close_matches(key, names, n=1)
+            hint = f" (did you mean {near[0]!r}?)" if near else ""
+            return AmclParamsError(f"unknown amcl parameter {key!r}{hint}")
+
+        kwargs = _KINDS.kwargs(params, names, ignored=IGNORED_PARAMETERS, unknown=unknown)
         return cls(**kwargs)
 
     @staticmethod
@@ -295,25 +288,6 @@ class AmclParams:
             self.odom_alpha4,
             self.odom_alpha5,
         )
-
-
-def _check_type(name: str, value: object) -> None:
-    if name in _STR_FIELDS:
-        if not isinstance(value, str) or not value:
-            raise AmclParamsError(f"{name} must be a non-empty string, got {value!r}")
-        return
-    if name in _BOOL_FIELDS:
-        if not isinstance(value, bool):
-            raise AmclParamsError(f"{name} must be true or false, got {value!r}")
-        return
-    if name in _INT_FIELDS:
-        if isinstance(value, bool) or not isinstance(value, int):
-            raise AmclParamsError(f"{name} must be an int, got {value!r}")
-        return
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        raise AmclParamsError(f"{name} must be a number, got {value!r}")
-    if not math.isfinite(value):
-        raise AmclParamsError(f"{name} must be finite, got {value!r}")
 
 
 def _check(ok: bool, msg: str) -> None:

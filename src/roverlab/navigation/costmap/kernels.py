@@ -49,33 +49,40 @@ def bresenham(x0: int, y0: int, x1: int, y1: int, max_length: int, out: NDArray[
     sy = 1 if dy > 0 else -1
     dist = math.hypot(dx, dy)
     scale = 1.0 if dist == 0.0 else min(1.0, max_length / dist)
-    x = x0
-    y = y0
+    if adx >= ady:  # x is the dominant axis
+        return _bresenham2d(out, x0, y0, sx, 0, 0, sy, adx, ady, scale)
+    return _bresenham2d(out, x0, y0, 0, sy, sx, 0, ady, adx, scale)
+
+
+@_jit
+def _bresenham2d(
+    out: NDArray[np.int64],
+    x: int,
+    y: int,
+    major_x: int,
+    major_y: int,
+    minor_x: int,
+    minor_y: int,
+    d_major: int,
+    d_minor: int,
+    scale: float,
+) -> int:
+    """costmap_2d's ``bresenham2D``: one step along the dominant axis each cell, one along
+    the other when the error overflows."""
+    err = d_major // 2
+    end = min(int(scale * d_major), d_major)
     n = 0
-    if adx >= ady:
-        err = adx // 2
-        end = min(int(scale * adx), adx)
-        for _ in range(end):
-            out[n, 0] = x
-            out[n, 1] = y
-            n += 1
-            x += sx
-            err += ady
-            if err >= adx:
-                y += sy
-                err -= adx
-    else:
-        err = ady // 2
-        end = min(int(scale * ady), ady)
-        for _ in range(end):
-            out[n, 0] = x
-            out[n, 1] = y
-            n += 1
-            y += sy
-            err += adx
-            if err >= ady:
-                x += sx
-                err -= ady
+    for _ in range(end):
+        out[n, 0] = x
+        out[n, 1] = y
+        n += 1
+        x += major_x
+        y += major_y
+        err += d_minor
+        if err >= d_major:
+            x += minor_x
+            y += minor_y
+            err -= d_major
     out[n, 0] = x
     out[n, 1] = y
     return n + 1

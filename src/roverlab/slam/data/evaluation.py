@@ -30,7 +30,6 @@ written from the log, a TUM file), else as numbers within 1 microsecond.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Final
@@ -38,6 +37,7 @@ from typing import Final
 import numpy as np
 from numpy.typing import NDArray
 
+from roverlab.slam.data._io import finite_floats, text_rows
 from roverlab.slam.data.errors import EvaluationError
 from roverlab.slam.data.trajectory import Trajectory
 
@@ -100,28 +100,16 @@ def read_relations(path: str | Path) -> Relations:
             named), or it holds no relation.
     """
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as err:
-        raise EvaluationError(f"{p}: cannot read: {err}") from err
     t1: list[str] = []
     t2: list[str] = []
     rows: list[tuple[float, float, float]] = []
-    for lineno, line in enumerate(text.splitlines(), start=1):
-        parts = line.split()
-        if not parts or parts[0].startswith("#"):
-            continue
+    for lineno, parts in text_rows(p, EvaluationError):
         if len(parts) != 8:
             raise EvaluationError(
                 f"{p}:{lineno}: expected 8 values (timestamp1 timestamp2 x y z roll pitch "
                 f"yaw), got {len(parts)}"
             )
-        try:
-            vals = [float(s) for s in parts]
-        except ValueError as err:
-            raise EvaluationError(f"{p}:{lineno}: not a number: {err}") from err
-        if not all(math.isfinite(v) for v in vals):
-            raise EvaluationError(f"{p}:{lineno}: non-finite value")
+        vals = finite_floats(parts, f"{p}:{lineno}", EvaluationError)
         t1.append(parts[0])
         t2.append(parts[1])
         rows.append((vals[2], vals[3], vals[7]))

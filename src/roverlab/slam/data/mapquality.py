@@ -32,10 +32,8 @@ Pure: arrays in, a small typed result out (no bus, no clock).
 
 from __future__ import annotations
 
-import contextlib
 import math
 import os
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -46,6 +44,7 @@ from numpy.typing import NDArray
 from PIL import Image
 from scipy import ndimage
 
+from roverlab.fileio import atomic_write
 from roverlab.geometry import SE2
 from roverlab.slam.data.errors import SlamError
 from roverlab.world import World
@@ -533,17 +532,8 @@ def write_overlay_png(
             (picture.width * scale, picture.height * scale), Image.Resampling.NEAREST
         )
     out = Path(path)
-    tmp: str | None = None
     try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{out.name}.", suffix=".tmp", dir=out.parent)
-        with os.fdopen(fd, "wb") as fh:
-            picture.save(fh, format="PNG")
-        os.replace(tmp, out)
-        tmp = None
+        atomic_write(out, lambda fh: picture.save(fh, format="PNG"))
     except OSError as err:
         raise MapQualityError(f"{out}: cannot write: {err.strerror or err}") from err
-    finally:
-        if tmp is not None:
-            with contextlib.suppress(OSError):
-                os.unlink(tmp)
     return out

@@ -23,7 +23,7 @@ from typing import Any, Final
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from roverlab.slam.data._io import atomic_write_text
+from roverlab.slam.data._io import atomic_write_text, text_rows
 from roverlab.slam.data.errors import PoseGraphError
 
 __all__ = [
@@ -156,20 +156,13 @@ def read_g2o(path: str | Path) -> PoseGraph:
             pose-graph one (landmarks, 3-D).
     """
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as err:
-        raise PoseGraphError(f"{p}: cannot read: {err}") from err
     vids: list[int] = []
     vposes: list[tuple[float, float, float]] = []
     efrom: list[int] = []
     eto: list[int] = []
     evals: list[list[float]] = []
     fix_ids: list[int] = []
-    for lineno, line in enumerate(text.splitlines(), start=1):
-        parts = line.split()
-        if not parts or parts[0].startswith("#"):
-            continue
+    for lineno, parts in text_rows(p, PoseGraphError):
         tag = parts[0]
         try:
             if tag == "VERTEX_SE2":

@@ -23,7 +23,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from roverlab.geometry import SE2, wrap_angle
-from roverlab.slam.data._io import atomic_write_text
+from roverlab.slam.data._io import atomic_write_text, finite_floats, text_rows
 from roverlab.slam.data.errors import TrajectoryError
 
 __all__ = ["Trajectory", "format_timestamp", "read_tum", "write_tum"]
@@ -194,24 +194,12 @@ def read_tum(path: str | Path) -> Trajectory:
             the file and line).
     """
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as err:
-        raise TrajectoryError(f"{p}: cannot read: {err}") from err
     texts: list[str] = []
     rows: list[tuple[float, float, float]] = []
-    for lineno, line in enumerate(text.splitlines(), start=1):
-        parts = line.split()
-        if not parts or parts[0].startswith("#"):
-            continue
+    for lineno, parts in text_rows(p, TrajectoryError):
         if len(parts) != 8:
             raise TrajectoryError(f"{p}:{lineno}: expected 8 values, got {len(parts)}")
-        try:
-            vals = [float(s) for s in parts]
-        except ValueError as err:
-            raise TrajectoryError(f"{p}:{lineno}: not a number: {err}") from err
-        if not all(math.isfinite(v) for v in vals):
-            raise TrajectoryError(f"{p}:{lineno}: non-finite value")
+        vals = finite_floats(parts, f"{p}:{lineno}", TrajectoryError)
         qx, qy, qz, qw = vals[4:]
         if qx * qx + qy * qy + qz * qz + qw * qw < 1e-12:
             raise TrajectoryError(f"{p}:{lineno}: zero quaternion")

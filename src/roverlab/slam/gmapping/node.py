@@ -31,32 +31,26 @@ from typing import Any
 
 import numpy as np
 
-from roverlab.core import Context, Duration, Node, QoSProfile
+from roverlab.core import Context, Duration
 from roverlab.geometry import Transform3
-from roverlab.msgs import Float64, MapMetaData, OccupancyGrid
+from roverlab.msgs import Float64
 from roverlab.msgs import classes as mc
 from roverlab.slam.gmapping.errors import GMappingInputError
 from roverlab.slam.gmapping.params import GMappingParams
 from roverlab.slam.gmapping.slam import GMapping
-from roverlab.slam.node_common import advertise_map_service, scan_inputs
+from roverlab.slam.node_common import SlamNode
 from roverlab.tf import (
-    Buffer,
     TfMessageFilter,
-    Throttle,
-    TransformBroadcaster,
-    TransformException,
-    TransformListener,
     transform_to_msg,
 )
 
 __all__ = ["SlamGMapping"]
 
-_LATCHED = QoSProfile(depth=1, durability="transient_local")
 # tf's MessageFilter queue of slam_gmapping (``new tf::MessageFilter(..., odom_frame_, 5)``)
 _FILTER_QUEUE = 5
 
 
-class SlamGMapping(Node):
+class SlamGMapping(SlamNode):
     """``slam_gmapping``: laser SLAM with a Rao-Blackwellised particle filter, live.
 
     Args:
@@ -90,19 +84,11 @@ class SlamGMapping(Node):
         self.seed = int(self.declare_parameter("seed", 0).value)
         p = self.params
         self.slam = GMapping(p, np.random.default_rng(self.seed))
-        self.map_msg: Any = None
         self.scans_processed = 0
         self.scans_received = 0
-        self._map_to_odom = Transform3()
         self._last_map_ns: int | None = None
         self._initialised = False
-        self._throttle = Throttle(self)
-        self.tf_buffer = Buffer()
-        self.tf_listener = TransformListener(self.tf_buffer, self)
-        self.tf_broadcaster = TransformBroadcaster(self)
-        self.map_publisher = self.create_publisher(OccupancyGrid, "map", _LATCHED)
-        self.map_service = advertise_map_service(self, lambda: self.map_msg)
-        self.metadata_publisher = self.create_publisher(MapMetaData, "map_metadata", _LATCHED)
+        self._setup_map_io()
         self.entropy_publisher = self.create_publisher(Float64, "~entropy", 10)
         self.scan_filter = TfMessageFilter(
             self, self.tf_buffer, [p.odom_frame], _FILTER_QUEUE, self._on_scan
@@ -116,31 +102,18 @@ class SlamGMapping(Node):
     def _on_scan(self, scan: Any) -> None:
         p = self.params
         self.scans_received += 1
-        try:
-            stamp, laser, odom = scan_inputs(self.tf_buffer, scan, p.base_frame, p.odom_frame)
-        except TransformException as err:
-            self._throttle.warning("odom", f"Failed to compute odom pose, skipping scan ({err})")
+        inputs = self._scan_inputs(scan, p.base_frame, p.odom_frame)
+        if inputs is None:
             return
+        stamp, laser, _ = inputs
         if not self._initialised:
             self._initialised = True
             if laser.upside_down:
                 self.get_logger().info("Laser is mounted upside down.")
             else:
                 self.get_logger().info("Laser is mounted upwards.")
-        try:
-            updated = self.slam.process(
-                np.asarray(scan.ranges, dtype=np.float64),
-                laser.angles,
-                odom,
-                stamp.nanoseconds / 1e9,
-                range_min=float(scan.range_min),
-                range_max=float(scan.range_max),
-                laser_offset=laser.offset,
-            )
-        except GMappingInputError as err:
-            self._throttle.warning("input", f"scan dropped: {err}")
-            return
-        if not updated:
+        ok, updated = self._process_scan(self.slam.process, scan, inputs, GMappingInputError)
+        if not (ok and updated):
             return
         self.scans_processed += 1
         self._map_to_odom = Transform3.from_se2(self.slam.map_to_odom())
@@ -153,10 +126,8 @@ class SlamGMapping(Node):
         grid = self.slam.occupancy()
         stamp = self.get_clock().now()
         msg = grid.to_msg(frame_id=self.params.map_frame, stamp=stamp)
-        self.map_msg = msg
         self.entropy_publisher.publish(Float64(data=self.entropy()))
-        self.map_publisher.publish(msg)
-        self.metadata_publisher.publish(msg.info)
+        self._publish_map_msg(msg)
 
     def entropy(self) -> float:
         """Entropy of the normalised particle weights (slam_gmapping's ``~entropy``)."""
@@ -165,11 +136,6 @@ class SlamGMapping(Node):
         return float(-np.sum(w * np.log(w)))
 
     # ------------------------------------------------------------------ TF
-    @property
-    def map_to_odom(self) -> Transform3:
-        """The ``map -> odom`` transform being broadcast."""
-        return self._map_to_odom
-
     def _publish_transform(self) -> None:
         p = self.params
         stamp = self.get_clock().now() + Duration.from_seconds(self._tf_delay)

@@ -18,6 +18,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from roverlab.core.rosparams import FieldKinds
 from roverlab.slam.gmapping.errors import GMappingParamsError
 
 __all__ = ["DEPRECATED_PARAMETERS", "NODE_PARAMETERS", "GMappingParams"]
@@ -37,9 +38,11 @@ NODE_PARAMETERS = frozenset(
 #: Names slam_gmapping once read and now ignores; accepted and dropped by ``from_ros``.
 DEPRECATED_PARAMETERS = frozenset({"inverted_laser"})
 
-_INT_FIELDS = frozenset({"throttle_scans", "kernelSize", "iterations", "lskip", "particles"})
-_STR_FIELDS = frozenset({"base_frame", "map_frame", "odom_frame"})
-_OPTIONAL_FIELDS = frozenset({"maxRange", "tf_delay"})
+_KINDS = FieldKinds(
+    ints=frozenset({"throttle_scans", "kernelSize", "iterations", "lskip", "particles"}),
+    strs=frozenset({"base_frame", "map_frame", "odom_frame"}),
+    optional=frozenset({"maxRange", "tf_delay"}),
+)
 
 # Upper bounds that keep a typo from allocating gigabytes or running for hours.
 _MAX_KERNEL = 10
@@ -139,8 +142,7 @@ class GMappingParams:
     tf_delay: float | None = None
 
     def __post_init__(self) -> None:
-        for f in dataclasses.fields(self):
-            _check_type(f.name, getattr(self, f.name))
+        _KINDS.check(self, GMappingParamsError)
         _check(self.throttle_scans >= 1, "throttle_scans must be >= 1")
         _check(self.map_update_interval >= 0.0, "map_update_interval must be >= 0")
         _check(self.maxRange is None or self.maxRange > 0.0, "maxRange must be > 0")
@@ -188,20 +190,12 @@ class GMappingParams:
             GMappingParamsError: an unknown name or a bad value.
         """
         names = {f.name for f in dataclasses.fields(cls)}
-        kwargs: dict[builtins.str, Any] = {}
-        for key, value in params.items():
-            if key in DEPRECATED_PARAMETERS:
-                continue
-            if key not in names:
-                raise GMappingParamsError(f"unknown slam_gmapping parameter {key!r}")
-            if isinstance(value, bool) or key in _STR_FIELDS:
-                kwargs[key] = value
-            elif key in _INT_FIELDS and isinstance(value, float) and value.is_integer():
-                kwargs[key] = int(value)
-            elif key not in _INT_FIELDS and isinstance(value, int):
-                kwargs[key] = float(value)
-            else:
-                kwargs[key] = value
+        kwargs = _KINDS.kwargs(
+            params,
+            names,
+            ignored=DEPRECATED_PARAMETERS,
+            unknown=lambda key: GMappingParamsError(f"unknown slam_gmapping parameter {key!r}"),
+        )
         return cls(**kwargs)
 
     @property
@@ -223,23 +217,6 @@ class GMappingParams:
 def _half_count(rng: float, step: float) -> int:
     """Grid points on one side of zero: ``0, step, 2 step, ... <= rng`` (float-safe)."""
     return int(math.floor(rng / step + 1e-9))
-
-
-def _check_type(name: builtins.str, value: object) -> None:
-    if name in _STR_FIELDS:
-        if not isinstance(value, builtins.str) or not value:
-            raise GMappingParamsError(f"{name} must be a non-empty string, got {value!r}")
-        return
-    if value is None and name in _OPTIONAL_FIELDS:
-        return
-    if name in _INT_FIELDS:
-        if isinstance(value, bool) or not isinstance(value, int):
-            raise GMappingParamsError(f"{name} must be an int, got {value!r}")
-        return
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        raise GMappingParamsError(f"{name} must be a number, got {value!r}")
-    if not math.isfinite(value):
-        raise GMappingParamsError(f"{name} must be finite, got {value!r}")
 
 
 def _check(ok: bool, msg: builtins.str) -> None:

@@ -49,6 +49,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from roverlab.geometry import SE2
+from roverlab.maps.grid import scan_arrays
 from roverlab.slam.common import ScanLike
 from roverlab.slam.gmapping import kernels
 from roverlab.slam.gmapping.errors import GMappingInputError
@@ -329,7 +330,7 @@ class GMapping:
         Raises:
             GMappingInputError: mismatched shapes, non-finite angles, odometry or time.
         """
-        r, a = _scan_arrays(ranges, angles)
+        r, a = scan_arrays(ranges, angles, GMappingInputError)
         odom = _odom_array(odom_pose)
         t = float(timestamp)
         if not math.isfinite(t):
@@ -759,18 +760,6 @@ def _draw_gaussian(
     out = mean + np.einsum("pij,pj->pi", root, z)
     out[:, 2] = wrap(out[:, 2])
     return out
-
-
-def _scan_arrays(
-    ranges: ArrayLike, angles: ArrayLike
-) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    r = np.asarray(ranges, dtype=np.float64).reshape(-1)
-    a = np.asarray(angles, dtype=np.float64).reshape(-1)
-    if r.shape != a.shape:
-        raise GMappingInputError(f"{r.size} ranges but {a.size} angles")
-    if not np.all(np.isfinite(a)):
-        raise GMappingInputError("beam angles must be finite")
-    return r, a
 
 
 def _odom_array(odom_pose: ArrayLike | SE2) -> NDArray[np.float64]:

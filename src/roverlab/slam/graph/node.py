@@ -34,29 +34,20 @@ from __future__ import annotations
 import dataclasses
 from typing import Any
 
-import numpy as np
-
-from roverlab.core import Context, Node, QoSProfile
+from roverlab.core import Context
 from roverlab.geometry import Transform3
-from roverlab.msgs import MapMetaData, OccupancyGrid, array_to_occupancy_grid
 from roverlab.msgs import classes as mc
 from roverlab.slam.graph.errors import GraphSlamInputError
 from roverlab.slam.graph.params import GraphParams
 from roverlab.slam.graph.slam import GraphSLAM
-from roverlab.slam.node_common import advertise_map_service, scan_inputs
+from roverlab.slam.node_common import SlamNode
 from roverlab.tf import (
-    Buffer,
     TfMessageFilter,
-    Throttle,
-    TransformBroadcaster,
-    TransformException,
-    TransformListener,
     transform_to_msg,
 )
 
 __all__ = ["NODE_DEFAULTS", "SlamKarto", "SlamToolbox", "SyncSlamToolbox"]
 
-_LATCHED = QoSProfile(depth=1, durability="transient_local")
 
 #: The node-level parameters this node implements, with slam_toolbox's defaults.
 NODE_DEFAULTS: dict[str, Any] = {
@@ -72,7 +63,7 @@ SYNC_QUEUE_LIMIT = 12_000
 SYNC_QUEUE_WARN = 10
 
 
-class SlamToolbox(Node):
+class SlamToolbox(SlamNode):
     """``slam_toolbox`` (asynchronous mapping): Karto-style graph SLAM, live.
 
     Args:
@@ -115,17 +106,9 @@ class SlamToolbox(Node):
         self.odom_frame = p.odom_frame.lstrip("/")
         self.map_frame = p.map_frame.lstrip("/")
         self.slam = GraphSLAM(p)
-        self.map_msg: Any = None
         self.scans_processed = 0
-        self._map_to_odom = Transform3()
         self._published_state: tuple[int, int] | None = None
-        self._throttle = Throttle(self)
-        self.tf_buffer = Buffer()
-        self.tf_listener = TransformListener(self.tf_buffer, self)
-        self.tf_broadcaster = TransformBroadcaster(self)
-        self.map_publisher = self.create_publisher(OccupancyGrid, "map", _LATCHED)
-        self.map_service = advertise_map_service(self, lambda: self.map_msg)
-        self.metadata_publisher = self.create_publisher(MapMetaData, "map_metadata", _LATCHED)
+        self._setup_map_io()
         queue = int(node["scan_queue_size"])
         self.scan_filter = TfMessageFilter(
             self, self.tf_buffer, [self.odom_frame], queue, self._on_scan
@@ -152,23 +135,11 @@ class SlamToolbox(Node):
         self.scan_filter.add(scan)
 
     def _on_scan(self, scan: Any) -> None:
-        try:
-            stamp, laser, odom = scan_inputs(self.tf_buffer, scan, self.base_frame, self.odom_frame)
-        except TransformException as err:
-            self._throttle.warning("odom", f"Failed to compute odom pose, skipping scan ({err})")
+        inputs = self._scan_inputs(scan, self.base_frame, self.odom_frame)
+        if inputs is None:
             return
-        try:
-            self.slam.process(
-                np.asarray(scan.ranges, dtype=np.float64),
-                laser.angles,
-                odom,
-                stamp.nanoseconds / 1e9,
-                range_min=float(scan.range_min),
-                range_max=float(scan.range_max),
-                laser_offset=laser.offset,
-            )
-        except GraphSlamInputError as err:
-            self._throttle.warning("input", f"scan dropped: {err}")
+        ok, _ = self._process_scan(self.slam.process, scan, inputs, GraphSlamInputError)
+        if not ok:
             return
         self.scans_processed += 1
         self._map_to_odom = Transform3.from_se2(self.slam.map_to_odom())
@@ -184,22 +155,7 @@ class SlamToolbox(Node):
         if state == self._published_state:
             return
         self._published_state = state
-        grid = self.slam.occupancy()
-        msg = array_to_occupancy_grid(
-            grid.data,
-            resolution=grid.resolution,
-            origin=(grid.origin[0], grid.origin[1], 0.0),
-            frame_id=self.map_frame,
-            stamp=self.get_clock().now(),
-        )
-        self.map_msg = msg
-        self.map_publisher.publish(msg)
-        self.metadata_publisher.publish(msg.info)
-
-    @property
-    def map_to_odom(self) -> Transform3:
-        """The ``map -> odom`` transform being broadcast."""
-        return self._map_to_odom
+        self._publish_map_msg(self._grid_msg(self.slam.occupancy(), self.map_frame))
 
     def _publish_transform(self) -> None:
         self.tf_broadcaster.send_transform(

@@ -55,7 +55,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import breadth_first_order
 
 from roverlab.geometry import SE2
-from roverlab.maps.grid import CountGrid
+from roverlab.maps.grid import CountGrid, scan_arrays
 from roverlab.slam.common import ScanLike
 from roverlab.slam.data.pose_solver import optimize
 from roverlab.slam.data.posegraph import PoseGraph, edge_errors
@@ -72,6 +72,7 @@ from roverlab.slam.graph.matcher import (
     valid_points,
 )
 from roverlab.slam.graph.params import GraphParams
+from roverlab.slam.laser import beam_endpoints
 
 __all__ = ["GraphMap", "GraphRun", "GraphSLAM", "ScanLike", "run_graph", "run_log"]
 
@@ -309,12 +310,7 @@ class GraphSLAM:
         Raises:
             GraphSlamInputError: mismatched shapes or non-finite angles.
         """
-        r = np.asarray(ranges, dtype=np.float64).reshape(-1)
-        a = np.asarray(angles, dtype=np.float64).reshape(-1)
-        if r.shape != a.shape:
-            raise GraphSlamInputError(f"{r.size} ranges but {a.size} angles")
-        if not np.all(np.isfinite(a)):
-            raise GraphSlamInputError("beam angles must be finite")
+        r, a = scan_arrays(ranges, angles, GraphSlamInputError)
         p = self.params
         with np.errstate(invalid="ignore"):
             keep = (
@@ -325,9 +321,7 @@ class GraphSLAM:
                 & (r <= p.max_laser_range)
             )
         off = self.laser_offset if laser_offset is None else laser_offset
-        ang = a[keep] + off.theta
-        rr = r[keep]
-        return np.stack([off.x + rr * np.cos(ang), off.y + rr * np.sin(ang)], axis=1)
+        return beam_endpoints(r[keep], a[keep], off)
 
     def process(
         self,

@@ -42,15 +42,12 @@ from typing import Any
 
 import numpy as np
 
-from roverlab.core import Context, Node, QoSProfile, Time
+from roverlab.core import Context, Time
 from roverlab.geometry import SE2, Transform3
 from roverlab.msgs import (
-    MapMetaData,
-    OccupancyGrid,
     Odometry,
     PoseStamped,
     PoseWithCovarianceStamped,
-    array_to_occupancy_grid,
     pose_from_xytheta,
 )
 from roverlab.msgs import classes as mc
@@ -58,20 +55,15 @@ from roverlab.slam.hector.errors import HectorInputError, OutOfMapError
 from roverlab.slam.hector.params import HectorParams
 from roverlab.slam.hector.slam import HectorSLAM
 from roverlab.slam.laser import laser_geometry
-from roverlab.slam.node_common import advertise_map_service
+from roverlab.slam.node_common import SlamNode
 from roverlab.tf import (
-    Buffer,
     TfMessageFilter,
-    Throttle,
-    TransformBroadcaster,
     TransformException,
-    TransformListener,
     transform_to_msg,
 )
 
 __all__ = ["NODE_DEFAULTS", "HectorMapping"]
 
-_LATCHED = QoSProfile(depth=1, durability="transient_local")
 # hector waits this long (s) for the laser's transform (``waitForTransform(..., 0.5)``)
 _TF_WAIT_S = 0.5
 
@@ -95,7 +87,7 @@ NODE_DEFAULTS: dict[str, Any] = {
 }
 
 
-class HectorMapping(Node):
+class HectorMapping(SlamNode):
     """``hector_mapping``: scan-matching SLAM on a multi-resolution grid, live.
 
     Args:
@@ -144,18 +136,9 @@ class HectorMapping(Node):
         self.slam = HectorSLAM(self.params)
         self.pose = SE2()
         self.scans_processed = 0
-        self.map_msg: Any = None
         self._published_updates = -1
-        self._map_to_odom = Transform3()
         self._failed = False
-        self._throttle = Throttle(self)
-        self.tf_buffer = Buffer()
-        self.tf_listener = TransformListener(self.tf_buffer, self)
-        self.tf_broadcaster = TransformBroadcaster(self)
-        self.map_publisher = self.create_publisher(OccupancyGrid, "map", _LATCHED)
-        if node["advertise_map_service"]:
-            self.map_service = advertise_map_service(self, lambda: self.map_msg)
-        self.metadata_publisher = self.create_publisher(MapMetaData, "map_metadata", _LATCHED)
+        self._setup_map_io(map_service=bool(node["advertise_map_service"]))
         self.pose_publisher = self.create_publisher(PoseStamped, "slam_out_pose", 1)
         self.pose_update_publisher = self.create_publisher(
             PoseWithCovarianceStamped, str(node["pose_update_topic"]), 1
@@ -184,7 +167,7 @@ class HectorMapping(Node):
         self.create_subscription(mc.String, str(node["sys_msg_topic"]), self._on_syscommand, 2)
         self.create_timer(float(node["map_pub_period"]), self.publish_map)
         # hector latches the (empty) map's metadata at start-up
-        self.metadata_publisher.publish(self._grid_msg().info)
+        self.metadata_publisher.publish(self._grid_msg(self.slam.occupancy(0), self.map_frame).info)
         log = self.get_logger()
         log.info(f"HectorSM base_frame: {self.base_frame}")
         log.info(f"HectorSM map_frame: {self.map_frame}")
@@ -297,31 +280,13 @@ class HectorMapping(Node):
             return np.zeros((3, 3))
         return np.asarray(np.linalg.pinv(h), dtype=np.float64)
 
-    @property
-    def map_to_odom(self) -> Transform3:
-        """The last ``map -> odom`` transform broadcast."""
-        return self._map_to_odom
-
     # ------------------------------------------------------------------ map
     def publish_map(self) -> None:
         """Publish ``map`` and ``map_metadata`` if the map changed since the last time."""
         if self.slam.map_updates == self._published_updates:
             return
         self._published_updates = self.slam.map_updates
-        msg = self._grid_msg()
-        self.map_msg = msg
-        self.map_publisher.publish(msg)
-        self.metadata_publisher.publish(msg.info)
-
-    def _grid_msg(self) -> Any:
-        grid = self.slam.occupancy(0)
-        return array_to_occupancy_grid(
-            grid.data,
-            resolution=grid.resolution,
-            origin=(grid.origin[0], grid.origin[1], 0.0),
-            frame_id=self.map_frame,
-            stamp=self.get_clock().now(),
-        )
+        self._publish_map_msg(self._grid_msg(self.slam.occupancy(0), self.map_frame))
 
     def _on_syscommand(self, msg: Any) -> None:
         text = str(msg.data)

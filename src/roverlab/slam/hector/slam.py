@@ -27,12 +27,14 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from roverlab.geometry import SE2, wrap_angle
+from roverlab.maps.grid import scan_arrays
 from roverlab.slam.common import ScanLike
 from roverlab.slam.data.trajectory import Trajectory
 from roverlab.slam.hector.errors import HectorInputError, OutOfMapError
 from roverlab.slam.hector.grid import HectorMap, MultiResGrid
 from roverlab.slam.hector.matcher import match
 from roverlab.slam.hector.params import HectorParams
+from roverlab.slam.laser import beam_endpoints
 
 __all__ = ["HectorRun", "HectorSLAM", "ScanLike", "run_log"]
 
@@ -140,12 +142,7 @@ class HectorSLAM:
         Raises:
             HectorInputError: mismatched shapes or non-finite angles.
         """
-        r = np.asarray(ranges, dtype=np.float64).reshape(-1)
-        a = np.asarray(angles, dtype=np.float64).reshape(-1)
-        if r.shape != a.shape:
-            raise HectorInputError(f"{r.size} ranges but {a.size} angles")
-        if not np.all(np.isfinite(a)):
-            raise HectorInputError("beam angles must be finite")
+        r, a = scan_arrays(ranges, angles, HectorInputError)
         p = self.params
         if not p.laser_z_min_value <= self.laser_z_m <= p.laser_z_max_value:
             return np.zeros((0, 2))
@@ -156,14 +153,8 @@ class HectorSLAM:
             & (r >= p.laser_min_dist)
             & (r < p.laser_max_dist)
         )
-        r = r[keep]
-        a = a[keep]
         off = self.laser_offset if laser_offset is None else laser_offset
-        ang = a + off.theta
-        pts = np.empty((r.size, 2))
-        pts[:, 0] = off.x + r * np.cos(ang)
-        pts[:, 1] = off.y + r * np.sin(ang)
-        return pts
+        return beam_endpoints(r[keep], a[keep], off)
 
     def process(
         self,

@@ -1,0 +1,29 @@
+"""In-process helpers for tests that run nodes or the ``roverlab`` command."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from roverlab.cli.main import main
+from roverlab.core import Context, QoSProfile
+
+__all__ = ["collect", "run_main"]
+
+
+def collect(ctx: Context, topics: dict[str, Any]) -> dict[str, list[Any]]:
+    """Subscribe a ``collector`` node to ``{topic: type}``; the returned lists fill up with
+    the messages (a queue of 1000 each)."""
+    got: dict[str, list[Any]] = {t: [] for t in topics}
+    node = ctx.create_node("collector")
+    for topic, typ in topics.items():
+        node.create_subscription(typ, topic, got[topic].append, QoSProfile(depth=1000))
+    return got
+
+
+def run_main(argv: list[str]) -> int:
+    """The ``roverlab`` entry point in this process: its exit code."""
+    try:
+        main(argv)
+    except SystemExit as done:
+        return int(done.code or 0)
+    return 0
