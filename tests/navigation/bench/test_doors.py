@@ -63,9 +63,8 @@ def test_global_plan_enters_a_narrow_door_along_its_axis() -> None:
 
 
 def test_dwa_nose_and_speeds_fit_mybot() -> None:
-    dwa: dict[str, Any] = yaml.safe_load((PARAMS / "dwa_local_planner_params.yaml").read_text())[
-        "DWAPlannerROS"
-    ]
+    data = yaml.safe_load((PARAMS / "dwa_local_planner_params.yaml").read_text())
+    dwa: dict[str, Any] = data["DWAPlannerROS"]
     # the forward point (nose) of DWA's goal-front and alignment critics stays within
     # the padded footprint's front reach + a cell (0.135 + 0.05 m) and closer than any
     # bench goal's clearance (circumscribed radius 0.174 m + 0.1 m), so it does not fall
@@ -78,7 +77,7 @@ def test_dwa_nose_and_speeds_fit_mybot() -> None:
 
 def test_dwa_drives_through_a_narrow_door_from_diagonal_approaches(tmp_path: Path) -> None:
     """Four goals on alternate sides of one door, each reached at a slant (mybot starts
-    0.55 m below the wall, 0.8 m beside the door, facing away from it). With the previous
+    0.55 m below the wall, 0.8 m beside the door, heading 160 degrees). With the previous
     parameters (0.55 / 66, forward point 0.325 m, occdist 0.1, min_vel_x -0.1) the first
     goal timed out after five recovery behaviours (mybot rocking in front of the door, 5 cm
     off its axis) and the last one needed a recovery and 1.31 x the shortest path."""
