@@ -49,8 +49,8 @@ def test_global_plan_enters_a_narrow_door_along_its_axis() -> None:
     for sx, sy in STARTS:
         goal = SE2(AXIS_X + (0.5 if sx < AXIS_X else -0.5), 2.0, 0.0)
         angle, off = _entry(planner.plan(SE2(sx, sy, 0.0), goal, lc.costmap))
-        # cost_factor 1.0 / neutral_cost 40: the last 0.15 m of the approach within 10
-        # degrees of the axis and the plan within 1 cm of it (the robot has 4 cm a side)
+        # cost_factor 1.0 / neutral_cost 40: from 0.35 to 0.2 m before the wall's centre
+        # within 10 degrees of the axis, then within 1 cm of it (mybot has 4 cm a side)
         assert angle < 10.0 and off < 0.01, (sx, sy, angle, off)
     # 0.55 / 66 (the Tuning Guide's values) kept the costs so flat that the plan cut the
     # jamb's corner: 16-24 degrees, 2-3 cm off the axis, where DWA could not line up
