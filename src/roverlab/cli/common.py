@@ -44,6 +44,7 @@ __all__ = [
 FOLLOWER_CLOCKS = ("auto", "wall", "external")
 
 _SETTLE_S = 0.3
+_LINK_WAIT_S = 2.0
 _CONNECT_TIMEOUT_S = 5.0
 _LOOPBACK_HOSTS = ("localhost", "::1", "ip6-localhost")
 
@@ -120,17 +121,29 @@ class Connection:
         self.context = Context(clock=clock, publish_clock=False)
         self.transport = ZenohTransport(options.zenoh_options())
         self.context.add_transport(self.transport)
-        # A fresh session's first graph or parameter query can come back empty until the
-        # router has sent it the network's declarations: give it that moment once.
+        # A fresh session's first graph or parameter query can come back empty until it is
+        # linked to the router (or a peer) and has the network's declarations: wait for
+        # the link (a loaded machine can take a second), then give the declarations a
+        # moment.
+        info = self.transport.session.info
+        deadline = time.monotonic() + _LINK_WAIT_S
+        while not (list(info.routers_zid()) or list(info.peers_zid())):
+            if time.monotonic() >= deadline:
+                break
+            time.sleep(0.02)
         time.sleep(_SETTLE_S)
+        self._fresh_until = time.monotonic() + _LINK_WAIT_S
 
     def graph(self, timeout_s: float = 1.0) -> list[GraphEntity]:
-        """Nodes, publishers and subscriptions of the other processes."""
-        return [
-            e
-            for e in query_graph(self.transport.session, self.transport.domain, timeout_s)
-            if e.zid != self.transport.zid
-        ]
+        """Nodes, publishers and subscriptions of the other processes. Shortly after
+        joining, an empty answer is asked again (the declarations may still be on their
+        way), so a busy machine does not make a running system look empty."""
+        session, domain, me = self.transport.session, self.transport.domain, self.transport.zid
+        while True:
+            ents = [e for e in query_graph(session, domain, timeout_s) if e.zid != me]
+            if ents or time.monotonic() >= self._fresh_until:
+                return ents
+            time.sleep(0.1)
 
     def close(self) -> None:
         self.context.shutdown()
