@@ -109,7 +109,12 @@ def test_action_status_topic_as_topic_echo_shows_it(node_proc: Any, cli: Any) ->
     finally:
         # Ctrl-C cancels the goal: the server preempts it and the command reports that
         goal.send_signal(signal.SIGINT)
-        out, err = goal.communicate(timeout=20)
+        try:
+            out, err = goal.communicate(timeout=20)
+        except subprocess.TimeoutExpired:
+            goal.kill()  # never leave the command running past the test
+            out, err = goal.communicate()
+            pytest.fail(f"send_goal did not end within 20 s of SIGINT; it printed: {out!r}")
     assert "Canceling goal..." in out, err
     assert "Goal finished with status: PREEMPTED (canceled)" in out
     assert goal.returncode == 1
