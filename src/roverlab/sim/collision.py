@@ -170,6 +170,16 @@ def polygon_hits_near(
 
 
 @numba.njit(cache=True, nogil=True)
+def _segment_within(x: float, y: float, r2: float, s: np.ndarray) -> bool:
+    return _point_segment_dist2(x, y, s[0], s[1], s[2], s[3]) <= r2
+
+
+@numba.njit(cache=True, nogil=True)
+def _circle_within(x: float, y: float, radius: float, c: np.ndarray) -> bool:
+    return math.hypot(c[0] - x, c[1] - y) - c[2] <= radius
+
+
+@numba.njit(cache=True, nogil=True)
 def any_near(
     x: float,
     y: float,
@@ -184,12 +194,10 @@ def any_near(
     ``radius`` of ``(x, y)``: when none does, a body inside that disc touches nothing."""
     r2 = radius * radius
     for j in range(n_segments):
-        s = segments[near[j]]
-        if _point_segment_dist2(x, y, s[0], s[1], s[2], s[3]) <= r2:
+        if _segment_within(x, y, r2, segments[near[j]]):
             return True
     for j in range(n_segments, n_segments + n_circles):
-        c = circles[near[j]]
-        if math.hypot(c[0] - x, c[1] - y) - c[2] <= radius:
+        if _circle_within(x, y, radius, circles[near[j]]):
             return True
     return False
 
@@ -209,15 +217,12 @@ def gather_near(
     r2 = reach * reach
     ns = 0
     for i in range(segments.shape[0]):
-        s = segments[i]
-        if _point_segment_dist2(x, y, s[0], s[1], s[2], s[3]) <= r2:
+        if _segment_within(x, y, r2, segments[i]):
             near[ns] = i
             ns += 1
     nc = 0
     for i in range(circles.shape[0]):
-        c = circles[i]
-        d = math.hypot(c[0] - x, c[1] - y) - c[2]
-        if d <= reach:
+        if _circle_within(x, y, reach, circles[i]):
             near[ns + nc] = i
             nc += 1
     return ns, nc
