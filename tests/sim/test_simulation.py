@@ -126,6 +126,29 @@ def test_a_late_tf_reader_gets_the_odometry_and_wheel_transforms() -> None:
     assert wheels == {"left_wheel_link", "right_wheel_link"}
 
 
+def test_the_camera_renders_only_while_someone_looks(monkeypatch: pytest.MonkeyPatch) -> None:
+    # gazebo_ros_camera's sensor is active only with subscribers: no frame is rendered
+    # while nobody reads /image_raw or /camera_info, a reader that joins gets 30 Hz
+    from roverlab.sim.sensors import CameraModel
+
+    renders: list[int] = []
+    real = CameraModel.capture_rgb
+
+    def counting(self: CameraModel, *args: Any) -> Any:
+        renders.append(1)
+        return real(self, *args)
+
+    monkeypatch.setattr(CameraModel, "capture_rgb", counting)
+    ctx = Context()
+    Simulation(context=ctx, world=_room(), robot="mybot")
+    ctx.spin_for(1.0)
+    assert renders == []
+    got = _collect(ctx, {"/image_raw": "sensor_msgs/msg/Image"})
+    ctx.spin_for(1.0)
+    assert len(got["/image_raw"]) == pytest.approx(30, abs=1)
+    assert len(renders) == len(got["/image_raw"])
+
+
 def _drive_square(seed: int, slip: float) -> tuple[float, float, Any, Any]:
     """Open-loop 1 m square; returns (truth closure error, encoder closure error, ...)."""
     ctx = Context()

@@ -501,7 +501,12 @@ class SimulatorNode(Node):
         image_pub = self.create_publisher(mc.Image, sensor.image_topic, 2)
         info_pub = self.create_publisher(mc.CameraInfo, sensor.info_topic, 2)
 
+        pubs = (image_pub, info_pub)
+
         def tick() -> None:
+            # rendered only while someone looks, as gazebo_ros_camera activates its sensor
+            if not any(pub.has_listeners for pub in pubs):
+                return
             ns = self.get_clock().now_ns()
             x, y, z, yaw, pitch = self.sensor_pose(sensor.mount)
             rgb = model.capture_rgb(self.scene, x, y, z, yaw, pitch)
@@ -519,7 +524,11 @@ class SimulatorNode(Node):
         points_pub = self.create_publisher(mc.PointCloud2, sensor.points_topic, 2)
         p = sensor.params
 
+        pubs = (image_pub, info_pub, depth_pub, dinfo_pub, points_pub)
+
         def tick() -> None:
+            if not any(pub.has_listeners for pub in pubs):  # as the colour camera
+                return
             ns = self.get_clock().now_ns()
             x, y, z, yaw, pitch = self.sensor_pose(sensor.mount)
             rgb, depth = model.capture(self.scene, x, y, z, yaw, pitch)
