@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import signal
 import subprocess
 import sys
 from collections.abc import Iterator
@@ -15,6 +16,14 @@ from tests.helpers.procs import Proc
 
 HELPERS = Path(__file__).parent / "helpers"
 REPO = Path(__file__).resolve().parents[1]
+
+
+# A shell without job control starts background commands with SIGINT ignored (POSIX), and
+# an ignored signal stays ignored in every child: `make test &` would make every Ctrl-C
+# test fail (the commands under test would never see their SIGINT). The tests' children
+# get SIGINT's default back (a caught signal is reset to the default at exec).
+if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 @pytest.fixture(scope="session", autouse=True)
