@@ -14,7 +14,7 @@ import socket
 import time
 import urllib.error
 import urllib.request
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -43,6 +43,7 @@ from roverlab.tf.convert import transform_to_msg
 from roverlab.viz import DashboardServer
 from roverlab.viz.config import DisplayConfig, default_config
 from tests.helpers.browser import CHROMIUM
+from tests.helpers.net import wait_until
 
 RESOLUTION_M = 0.05
 VIEWPORT = {"width": 1600, "height": 900}
@@ -65,15 +66,6 @@ class Live:
     robot: tuple[float, float]
     map_dir: Path
     got: dict[str, list[Any]] = field(default_factory=dict)
-
-
-def _wait(cond: Callable[[], bool], timeout_s: float = 10.0) -> bool:
-    deadline = time.monotonic() + timeout_s
-    while time.monotonic() < deadline:
-        if cond():
-            return True
-        time.sleep(0.05)
-    return cond()
 
 
 def _extra_displays() -> list[DisplayConfig]:
@@ -372,7 +364,7 @@ def test_nav_goal_tool_publishes_the_clicked_pose(live: Live, page: Any) -> None
     v = _view(page)
     start = (int(v["w"] / 2 + 150), int(v["h"] / 2 - 100))
     wx, wy = _drag_tool(page, "goal", start, (60, -60))
-    assert _wait(lambda: len(live.got["goal"]) > 0), "no /move_base_simple/goal"
+    assert wait_until(lambda: len(live.got["goal"]) > 0), "no /move_base_simple/goal"
     msg = live.got["goal"][-1]
     x, y, yaw = xytheta_from_pose(msg.pose)
     assert msg.header.frame_id == "map"
@@ -401,7 +393,7 @@ def test_pose_estimate_tool_publishes_initialpose(
 
     monkeypatch.setattr(live.amcl, "_apply_initial", spy)
     wx, wy = _drag_tool(page, "initialpose", start, (-80, 40))
-    assert _wait(lambda: len(live.got["initialpose"]) > 0), "no /initialpose"
+    assert wait_until(lambda: len(live.got["initialpose"]) > 0), "no /initialpose"
     msg = live.got["initialpose"][-1]
     x, y, yaw = xytheta_from_pose(msg.pose.pose)
     assert math.hypot(x - wx, y - wy) < 0.04
@@ -412,7 +404,7 @@ def test_pose_estimate_tool_publishes_initialpose(
     # amcl takes it: the pose as clicked (the robot stands still), its particles re-drawn
     # around it (0.5 m spread)
     assert math.hypot(before[0] - wx, before[1] - wy) > 1.0
-    assert _wait(lambda: bool(applied)), "amcl did not re-initialise at the 2D Pose Estimate"
+    assert wait_until(lambda: bool(applied)), "amcl did not re-initialise at the 2D Pose Estimate"
     px, py, mx, my = applied[-1]
     assert math.hypot(px - wx, py - wy) < 0.04
     assert math.hypot(mx - wx, my - wy) < 0.15
@@ -426,12 +418,12 @@ def test_tools_follow_a_rotated_view(live: Live, page: Any) -> None:
         assert abs(v["angle"] - math.pi / 12) < 1e-9
         start = (int(v["w"] / 2 + 100), int(v["h"] / 2 + 50))
         wx, wy = _drag_tool(page, "point", start, (0, 0))
-        assert _wait(lambda: len(live.got["point"]) > 0), "no /clicked_point"
+        assert wait_until(lambda: len(live.got["point"]) > 0), "no /clicked_point"
         p = live.got["point"][-1].point
         assert math.hypot(p.x - wx, p.y - wy) < 0.04
         n = len(live.got["goal"])
         _drag_tool(page, "goal", start, (60, 0))  # right on screen
-        assert _wait(lambda: len(live.got["goal"]) > n)
+        assert wait_until(lambda: len(live.got["goal"]) > n)
         _, _, yaw = xytheta_from_pose(live.got["goal"][-1].pose)
         assert abs(yaw - math.pi / 12) < 0.05  # screen right is 15 degrees in the world
     finally:
@@ -458,7 +450,7 @@ def test_depth_image_is_shown_with_a_colour_map(live: Live, page: Any, tmp_path:
     )
     page.select_option("#image-topic", "/test/depth")
     try:
-        assert _wait(
+        assert wait_until(
             lambda: any(
                 d.kind == "image" and d.topic == "/test/depth"
                 for d in live.server.bridge.config.displays
@@ -483,7 +475,7 @@ def test_depth_image_is_shown_with_a_colour_map(live: Live, page: Any, tmp_path:
 
 @browser_only
 def test_key_i_drives_the_robot_forward(live: Live, page: Any) -> None:
-    assert _wait(lambda: len(live.got["odom"]) > 0)
+    assert wait_until(lambda: len(live.got["odom"]) > 0)
     x0, y0, yaw0 = xytheta_from_pose(live.got["odom"][-1].pose.pose)
     page.locator("#view").click(position={"x": 5, "y": 5})  # focus; Move Camera tool is active
     page.keyboard.down("i")
@@ -518,33 +510,33 @@ def test_side_panel_toggles_and_configures_displays(live: Live, page: Any) -> No
     box = page.locator(f"#displays .display[data-slot='{slot}']")
     box.locator(".enabled").uncheck()
     try:
-        assert _wait(lambda: not bridge.config.displays[slot].enabled)
-        assert _wait(lambda: bridge.displays[slot].sub is None), "still subscribed to /scan"
+        assert wait_until(lambda: not bridge.config.displays[slot].enabled)
+        assert wait_until(lambda: bridge.displays[slot].sub is None), "still subscribed to /scan"
     finally:
         box.locator(".enabled").check()
-    assert _wait(lambda: bridge.displays[slot].sub is not None)
+    assert wait_until(lambda: bridge.displays[slot].sub is not None)
     box.locator(".dhead").click()  # expand, then set the decay time
     box.locator("input[data-option='decay_s']").fill("2")
     box.locator("input[data-option='decay_s']").press("Enter")
-    assert _wait(lambda: bridge.config.displays[slot].option("decay_s") == 2.0)
+    assert wait_until(lambda: bridge.config.displays[slot].option("decay_s") == 2.0)
     # scans accumulate for the decay time
     page.wait_for_function(f"() => viz.data.layers[{slot}].points.length > 2", timeout=10000)
     box.locator("input[data-option='decay_s']").fill("0")
     box.locator("input[data-option='decay_s']").press("Enter")
-    assert _wait(lambda: bridge.config.displays[slot].option("decay_s") == 0.0)
+    assert wait_until(lambda: bridge.config.displays[slot].option("decay_s") == 0.0)
     mslot = next(i for i, d in enumerate(bridge.config.displays) if d.name == "Map")
     mbox = page.locator(f"#displays .display[data-slot='{mslot}']")
     mbox.locator(".dhead").click()
     mbox.locator("select[data-option='color_scheme']").select_option("costmap")
-    assert _wait(lambda: bridge.config.displays[mslot].option("color_scheme") == "costmap")
+    assert wait_until(lambda: bridge.config.displays[mslot].option("color_scheme") == "costmap")
     assert page.evaluate(f"() => viz.data.layers[{mslot}].map.scheme") == "costmap"
     mbox.locator("select[data-option='color_scheme']").select_option("map")
-    assert _wait(lambda: bridge.config.displays[mslot].option("color_scheme") == "map")
+    assert wait_until(lambda: bridge.config.displays[mslot].option("color_scheme") == "map")
     # the fixed frame selector
     page.select_option("#fixed-frame", "odom")
-    assert _wait(lambda: bridge.config.fixed_frame == "odom")
+    assert wait_until(lambda: bridge.config.fixed_frame == "odom")
     page.select_option("#fixed-frame", "map")
-    assert _wait(lambda: bridge.config.fixed_frame == "map")
+    assert wait_until(lambda: bridge.config.fixed_frame == "map")
 
 
 @browser_only
