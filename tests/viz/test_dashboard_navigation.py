@@ -22,7 +22,8 @@ from roverlab.sim.node import SimulatorNode
 from roverlab.viz import DashboardServer
 from roverlab.viz.config import load_rviz
 from tests.helpers.browser import CHROMIUM, CHROMIUM_ARGS
-from tests.viz.test_dashboard import VIEWPORT, _wait
+from tests.helpers.net import wait_until
+from tests.viz.test_dashboard import VIEWPORT
 
 playwright_sync = pytest.importorskip("playwright.sync_api", reason="playwright not installed")
 
@@ -78,7 +79,7 @@ def test_2d_nav_goal_in_the_dashboard_drives_the_robot(nav: Nav, tmp_path: Path)
             " && viz.data.state.robot.length > 0 && viz.view.placed",
             timeout=30000,
         )
-        assert _wait(lambda: nav.move_base.global_costmap.ready, 20.0)
+        assert wait_until(lambda: nav.move_base.global_costmap.ready, 20.0)
         # the Footprint (rviz/PolygonStamped) display draws the local costmap's footprint
         assert not nav.server.bridge.config.unsupported
         page.wait_for_function(
@@ -98,7 +99,7 @@ def test_2d_nav_goal_in_the_dashboard_drives_the_robot(nav: Nav, tmp_path: Path)
         page.mouse.up()
         page.wait_for_timeout(1500)
         page.locator("#view3d").screenshot(path=str(tmp_path / "nav_goal_underway.png"))
-        assert _wait(lambda: bool(nav.results), 120.0), "no result on /move_base/result"
+        assert wait_until(lambda: bool(nav.results), 120.0), "no result on /move_base/result"
         status = nav.results[-1].status
         assert (status.status, status.text) == (3, "Goal reached.")  # SUCCEEDED
         assert math.hypot(nav.sim.x - gx, nav.sim.y - gy) < 0.2
