@@ -36,7 +36,7 @@ import dataclasses
 import math
 import time
 from collections.abc import Callable
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -63,7 +63,8 @@ from roverlab.navigation.move_base.plugins import (
 )
 from roverlab.navigation.move_base.recovery import ClearCostmapRecovery, RotateRecovery
 from roverlab.navigation.node_params import parameters_under
-from roverlab.navigation.planners import path_to_msg
+from roverlab.navigation.planners import Path2D, path_to_msg
+from roverlab.navigation.planners.footprint_check import plan_clear_of_footprint
 from roverlab.tf import Buffer, Throttle, TransformException, TransformListener
 
 __all__ = ["MoveBase", "TimingHook"]
@@ -391,6 +392,14 @@ class MoveBase(Node):
             self.recovery_trigger = PLANNING_R
             self.publish_zero_velocity()
 
+    def _global_plan(self, planner: Any, start: SE2, goal: SE2) -> Path2D:
+        """The global planner's plan, kept clear of the footprint unless
+        ``plan_footprint_check`` is off."""
+        cm = self.global_costmap.costmap
+        if not self.params.plan_footprint_check:
+            return cast(Path2D, planner.plan(start, goal, cm))
+        return plan_clear_of_footprint(planner, start, goal, cm, self.global_costmap.footprint)
+
     def _make_plan(self, gpose: SE2 | None, now: float) -> bool:
         """Plan from the robot to the goal; True on success (the plan is then in use)."""
         assert self.goal is not None
@@ -410,7 +419,7 @@ class MoveBase(Node):
             return False
         try:
             with _Timed(self.timing_hook, "plan"):
-                path = self.planner.plan(gpose, self.goal, self.global_costmap.costmap)
+                path = self._global_plan(self.planner, gpose, self.goal)
         except GoalOutsideMapBoundsError as err:
             if not self.global_costmap.layered.rolling_window:
                 self._abort(f"Aborting on goal because it is outside the global costmap: {err}")
@@ -562,7 +571,7 @@ class MoveBase(Node):
         if tol > 0 and hasattr(planner, "params"):  # the request's tolerance, for this plan
             planner = type(planner)(dataclasses.replace(planner.params, default_tolerance=tol))
         try:
-            path = planner.plan(start, goal, self.global_costmap.costmap)
+            path = self._global_plan(planner, start, goal)
         except PlannerError as err:
             self.get_logger().warning(f"make_plan: {err}")
             response.plan = Path(header_frame_id=self.global_frame)

@@ -83,6 +83,9 @@ class MoveBaseParams:
             goal comes or the local planner fails).
         max_planning_retries: planning failures before recovery (-1: until
             ``planner_patience``).
+        plan_footprint_check: roverlab's addition (not in ROS): re-plan around places
+            where the footprint, heading along the plan, would touch a lethal cell
+            (:mod:`roverlab.navigation.planners.footprint_check`); false plans as ROS does.
     """
 
     base_global_planner: str = "navfn/NavfnROS"
@@ -99,6 +102,7 @@ class MoveBaseParams:
     oscillation_distance: float = 0.5
     planner_frequency: float = 0.0
     max_planning_retries: int = -1
+    plan_footprint_check: bool = True
 
     def __post_init__(self) -> None:
         w = "move_base"
