@@ -57,20 +57,20 @@ def path_headings(path: NDArray[np.float64], span: int = HEADING_SPAN) -> NDArra
 @numba.njit(cache=True, nogil=True)
 def _infeasible(
     costs: NDArray[np.uint8],
-    res: float,
-    ox: float,
-    oy: float,
+    geometry: tuple[float, float, float],
     path: NDArray[np.float64],
     check: NDArray[np.bool_],
     fp: NDArray[np.float64],
-    shifts: NDArray[np.float64],
-    turns: NDArray[np.float64],
-    lethal: int,
+    moves: tuple[NDArray[np.float64], NDArray[np.float64]],
     hits: NDArray[np.bool_],
 ) -> int:
     """Mark the checked poses (rows ``x, y, heading``) at which no placement, shifted
-    sideways by one of ``shifts`` (m) and turned by one of ``turns`` (rad), keeps the
-    outline of ``fp`` off lethal cells; returns how many."""
+    sideways by one of ``moves[0]`` (m) and turned by one of ``moves[1]`` (rad), keeps the
+    outline of ``fp`` off the lethal cells of ``costs`` (``geometry``: resolution and
+    origin); returns how many."""
+    res, ox, oy = geometry
+    shifts, turns = moves
+    lethal = LETHAL_OBSTACLE
     h, w = costs.shape
     flat = costs.reshape(-1)
     buf = np.empty(fp.shape[0] * 2 * (w + h) + 8, dtype=np.int64)
@@ -124,12 +124,10 @@ def colliding_poses(
     d0 = np.hypot(poses[:, 0] - poses[0, 0], poses[:, 1] - poses[0, 1])
     d1 = np.hypot(poses[:, 0] - poses[-1, 0], poses[:, 1] - poses[-1, 1])
     check = (d0 > skip_radius) & (d1 > skip_radius)
-    _infeasible(
-        costmap.costs, costmap.resolution, costmap.origin_x, costmap.origin_y, poses, check,
-        np.ascontiguousarray(footprint, dtype=np.float64),
-        np.asarray(shifts, dtype=np.float64), np.asarray(turns, dtype=np.float64),
-        LETHAL_OBSTACLE, hits,
-    )  # fmt: skip
+    geometry = (costmap.resolution, costmap.origin_x, costmap.origin_y)
+    moves = (np.asarray(shifts, dtype=np.float64), np.asarray(turns, dtype=np.float64))
+    fp = np.ascontiguousarray(footprint, dtype=np.float64)
+    _infeasible(costmap.costs, geometry, poses, check, fp, moves, hits)
     return hits
 
 
