@@ -114,6 +114,10 @@ def test_goal_reached_with_feedback_plans_and_costmaps(stack: Stack) -> None:
     assert max(costs) < 253
     assert s.cmds[-1] == (0.0, 0.0)  # stopped at the goal
     assert not s.sim.contact
+    # the plan's footprint check looks at the static layer's map (the walls), which
+    # covers the global costmap cell for cell
+    static = s.move_base.global_costmap.layered.plugin("static_layer")
+    assert s.move_base._walls(grid) is static.grid  # type: ignore[attr-defined]
 
 
 def test_a_new_goal_preempts_the_current_one(stack: Stack) -> None:
@@ -282,7 +286,8 @@ def test_teb_in_the_full_stack_reaches_goals_on_time(monkeypatch: pytest.MonkeyP
         assert seen and s.sim.contacts == 0
         assert len(cpu) > 100 and len(errors) <= len(cpu) // 20
         # the band stays short: no control cycle near a second (it was seconds before the
-        # banded solver); the 25 ms target is measured by `roverlab nav bench`
-        assert max(cpu) < 0.5, max(cpu)
+        # banded solver); the 25 ms target is measured by `roverlab nav bench`. The first
+        # cycle compiles TEB's kernels when no earlier test in this process did (10 s cold).
+        assert max(cpu[1:]) < 0.5, max(cpu[1:])
     finally:
         s.ctx.shutdown()

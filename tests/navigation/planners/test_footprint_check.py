@@ -120,3 +120,21 @@ def test_plans_through_a_narrow_door_are_kept() -> None:
         plain = _planner().plan(start, goal, lc.costmap)
         path = plan_clear_of_footprint(_planner(), start, goal, lc.costmap, lc.footprint)
         np.testing.assert_array_equal(path, plain)
+
+
+def test_a_sensor_mark_in_the_gap_does_not_shut_it_with_the_walls_given() -> None:
+    """move_base checks against the static layer's map: one laser mark on the jamb's side
+    of a six-cell gap makes it five in the master costmap (the held-out narrow_doors run
+    checking the master grid turned mybot back inside a door, 94 of 100), not in the walls."""
+    grid, corner = _table_grid(0.31)
+    assert int((grid[30, 40:78] == 0).sum()) == 6
+    walls = _global_costmap(grid).costmap
+    marked = grid.copy()
+    marked[30, 72] = 100  # the first free cell east of the table at the narrowest
+    lc = _global_costmap(marked)
+    on_master = plan_clear_of_footprint(_planner(), START, GOAL, lc.costmap, lc.footprint)
+    assert _distance_to(on_master, corner) > 0.5
+    on_walls = plan_clear_of_footprint(
+        _planner(), START, GOAL, lc.costmap, lc.footprint, walls=walls
+    )
+    assert _distance_to(on_walls, corner) < 0.2

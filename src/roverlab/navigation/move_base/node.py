@@ -46,8 +46,10 @@ from roverlab.geometry import SE2
 from roverlab.msgs import Path, PoseStamped, Twist, pose_from_xytheta, xytheta_from_pose
 from roverlab.msgs import classes as mc
 from roverlab.navigation.controllers import Velocity2D
+from roverlab.navigation.costmap.costmap_2d import Costmap2D
 from roverlab.navigation.costmap.footprint import footprint_radii
 from roverlab.navigation.costmap.node import Costmap2DROS
+from roverlab.navigation.costmap.static_layer import StaticLayer
 from roverlab.navigation.errors import (
     ControllerError,
     GoalOutsideMapBoundsError,
@@ -398,7 +400,26 @@ class MoveBase(Node):
         cm = self.global_costmap.costmap
         if not self.params.plan_footprint_check:
             return cast(Path2D, planner.plan(start, goal, cm))
-        return plan_clear_of_footprint(planner, start, goal, cm, self.global_costmap.footprint)
+        return plan_clear_of_footprint(
+            planner, start, goal, cm, self.global_costmap.footprint, walls=self._walls(cm)
+        )
+
+    def _walls(self, cm: Costmap2D) -> Costmap2D | None:
+        """The static layer's map when it covers the global costmap cell for cell: the
+        footprint check looks at the walls, not at the sensors' marks (a door's jambs
+        marked a cell wider by the laser must not shut it from one plan to the next)."""
+        for layer in self.global_costmap.layered.plugins:
+            grid = getattr(layer, "grid", None)
+            if (
+                isinstance(layer, StaticLayer)
+                and layer.enabled
+                and layer.map_received
+                and grid is not None
+                and (grid.size_x, grid.size_y, grid.resolution, grid.origin_x, grid.origin_y)
+                == (cm.size_x, cm.size_y, cm.resolution, cm.origin_x, cm.origin_y)
+            ):
+                return cast(Costmap2D, grid)
+        return None
 
     def _make_plan(self, gpose: SE2 | None, now: float) -> bool:
         """Plan from the robot to the goal; True on success (the plan is then in use)."""

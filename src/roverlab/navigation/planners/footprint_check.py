@@ -156,9 +156,12 @@ def plan_clear_of_footprint(
     footprint: ArrayLike,
     *,
     rounds: int = MAX_ROUNDS,
+    walls: Costmap2D | None = None,
 ) -> Path2D:
     """``planner.plan(start, goal, costmap)``, re-planned around places where the footprint
-    has no room (see the module docstring).
+    has no room (see the module docstring) among the lethal cells of ``walls`` (a costmap
+    of ``costmap``'s geometry: move_base passes the static layer's map) or, without it, of
+    ``costmap``.
 
     Raises:
         PlannerError: the first plan failed (as ``planner.plan`` raises it).
@@ -167,6 +170,7 @@ def plan_clear_of_footprint(
     fp = np.asarray(footprint, dtype=np.float64).reshape(-1, 2)
     if len(fp) < 3 or rounds <= 0:
         return first
+    fixed = costmap if walls is None else walls
     res = costmap.resolution
     inscribed, _ = footprint_radii(fp)
     wide = pad_footprint(fp, MARGIN_CELLS * res)
@@ -175,7 +179,7 @@ def plan_clear_of_footprint(
     turns = np.radians([0.0, *(s * a for a in np.arange(7.5, 45.1, 7.5) for s in (1, -1))])
 
     def stuck(path: Path2D) -> NDArray[np.bool_]:
-        return colliding_poses(path, costmap, wide, skip_radius=skip, shifts=shifts, turns=turns)
+        return colliding_poses(path, fixed, wide, skip_radius=skip, shifts=shifts, turns=turns)
 
     path = first
     work: Costmap2D | None = None
