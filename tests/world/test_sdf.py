@@ -225,72 +225,37 @@ def test_state_pose_overrides_model_and_link_poses(tmp_path: Path) -> None:
     assert b == pytest.approx((0.0, -7.0, 0.5))  # the link's state pose is a world pose
 
 
-BUILDING = """
-<model name='my_building'>
-  <link name='Wall_0'>
-    <collision name='Wall_0_Collision'>
+def building_wall(i: int, pose: str, ambient: str = "1 1 1 1", meta: str = "") -> str:
+    """One wall link as the Building Editor saves it (4.15 m long, 2.5 m high)."""
+    return f"""
+  <link name='Wall_{i}'>
+    <collision name='Wall_{i}_Collision'>
       <geometry><box><size>4.15 0.15 2.5</size></box></geometry>
       <pose frame=''>0 0 1.25 0 -0 0</pose>
     </collision>
-    <visual name='Wall_0_Visual'>
+    <visual name='Wall_{i}_Visual'>
       <pose frame=''>0 0 1.25 0 -0 0</pose>
       <geometry><box><size>4.15 0.15 2.5</size></box></geometry>
       <material>
         <script><uri>file://media/materials/scripts/gazebo.material</uri><name>Gazebo/Grey</name></script>
-        <ambient>1 1 1 1</ambient>
-      </material>
-      <meta><layer>0</layer></meta>
+        <ambient>{ambient}</ambient>
+      </material>{meta}
     </visual>
-    <pose frame=''>0 -2 0 0 -0 0</pose>
-  </link>
-  <link name='Wall_1'>
-    <collision name='Wall_1_Collision'>
-      <geometry><box><size>4.15 0.15 2.5</size></box></geometry>
-      <pose frame=''>0 0 1.25 0 -0 0</pose>
-    </collision>
-    <visual name='Wall_1_Visual'>
-      <pose frame=''>0 0 1.25 0 -0 0</pose>
-      <geometry><box><size>4.15 0.15 2.5</size></box></geometry>
-      <material>
-        <script><uri>file://media/materials/scripts/gazebo.material</uri><name>Gazebo/Grey</name></script>
-        <ambient>0.921569 0.807843 0.615686 1</ambient>
-      </material>
-    </visual>
-    <pose frame=''>2 0 0 0 -0 1.5708</pose>
-  </link>
-  <link name='Wall_2'>
-    <collision name='Wall_2_Collision'>
-      <geometry><box><size>4.15 0.15 2.5</size></box></geometry>
-      <pose frame=''>0 0 1.25 0 -0 0</pose>
-    </collision>
-    <visual name='Wall_2_Visual'>
-      <pose frame=''>0 0 1.25 0 -0 0</pose>
-      <geometry><box><size>4.15 0.15 2.5</size></box></geometry>
-      <material>
-        <script><uri>file://media/materials/scripts/gazebo.material</uri><name>Gazebo/Grey</name></script>
-        <ambient>1 1 1 1</ambient>
-      </material>
-    </visual>
-    <pose frame=''>0 2 0 0 -0 3.14159</pose>
-  </link>
-  <link name='Wall_3'>
-    <collision name='Wall_3_Collision'>
-      <geometry><box><size>4.15 0.15 2.5</size></box></geometry>
-      <pose frame=''>0 0 1.25 0 -0 0</pose>
-    </collision>
-    <visual name='Wall_3_Visual'>
-      <pose frame=''>0 0 1.25 0 -0 0</pose>
-      <geometry><box><size>4.15 0.15 2.5</size></box></geometry>
-      <material>
-        <script><uri>file://media/materials/scripts/gazebo.material</uri><name>Gazebo/Grey</name></script>
-        <ambient>1 1 1 1</ambient>
-      </material>
-    </visual>
-    <pose frame=''>-2 0 0 0 -0 -1.5708</pose>
-  </link>
+    <pose frame=''>{pose}</pose>
+  </link>"""
+
+
+BUILDING = (
+    "\n<model name='my_building'>"
+    + building_wall(0, "0 -2 0 0 -0 0", meta="\n      <meta><layer>0</layer></meta>")
+    + building_wall(1, "2 0 0 0 -0 1.5708", ambient="0.921569 0.807843 0.615686 1")
+    + building_wall(2, "0 2 0 0 -0 3.14159")
+    + building_wall(3, "-2 0 0 0 -0 -1.5708")
+    + """
   <static>1</static>
   <pose frame=''>-3.1 0.4 0 0 -0 0</pose>
 </model>"""
+)
 
 
 def test_building_editor_walls_as_saved_by_save_world_as(tmp_path: Path) -> None:
