@@ -40,6 +40,7 @@ from roverlab.slam.gmapping import (
     kernels,
 )
 from roverlab.slam.gmapping.motion import compose, relative
+from tests.slam.synthetic import scan_record
 
 #: ``../shared/data`` relative to the repository root (never copied into the repository).
 DATA = Path(__file__).resolve().parents[2].parent / "shared" / "data"
@@ -68,21 +69,8 @@ RANGE_MAX_M = 10.0
 BEAMS = np.radians(np.arange(-135.0, 135.5, 1.0))  # a 270 degree, 1 degree scanner
 
 
-class Record(NamedTuple):
-    """A synthetic scan, shaped like ``roverlab.slam.data.logs.ScanRecord``."""
-
-    timestamp: float
-    ranges: NDArray[np.float32]
-    angle_min: float
-    angle_increment: float
-    range_min: float
-    range_max: float
-    odom_pose: SE2
-    laser_offset: SE2
-
-
 class Scenario(NamedTuple):
-    records: list[Record]
+    records: list[ScanRecord]
     truth: NDArray[np.float64]  # (N, 3) true robot poses
     odom: NDArray[np.float64]  # (N, 3) drifting odometry poses
 
@@ -150,15 +138,15 @@ def make_scenario(
         laser = compose(pose, LASER_OFFSET.as_array())
         r = cast_2d(scene, laser[0], laser[1], LASER_Z_M, BEAMS + laser[2], RANGE_MAX_M)
         r = r + rng.normal(0.0, 0.01, r.shape)
+        odom_pose = SE2(*(float(v) for v in odom[k]))
         records.append(
-            Record(
-                timestamp=0.2 * k,
-                ranges=r.astype(np.float32),
-                angle_min=float(BEAMS[0]),
-                angle_increment=float(BEAMS[1] - BEAMS[0]),
+            scan_record(
+                0.2 * k,
+                r,
+                BEAMS,
+                odom_pose,
                 range_min=0.05,
                 range_max=RANGE_MAX_M,
-                odom_pose=SE2(*(float(v) for v in odom[k])),
                 laser_offset=LASER_OFFSET,
             )
         )

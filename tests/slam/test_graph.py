@@ -46,6 +46,7 @@ from roverlab.slam.graph.matcher import _lattice_responses
 from roverlab.slam.graph.node import SlamKarto, SlamToolbox
 from roverlab.tf import Buffer, TransformListener
 from roverlab.world.yaml_world import world_from_dict
+from tests.slam.synthetic import scan_record
 
 DATA = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "radish"
 
@@ -133,16 +134,9 @@ def _records(seed: int = 3) -> tuple[list[ScanRecord], NDArray[np.float64]]:
     for i, (t, o) in enumerate(zip(truth, odom, strict=True)):
         r = cast_2d(scene, t[0], t[1], 0.5, t[2] + _ANGLES, _RANGE_MAX)
         r = np.where(np.isfinite(r), r + rng.normal(0.0, 0.01, r.shape), np.inf)
+        odom_pose = SE2(float(o[0]), float(o[1]), float(o[2]))
         recs.append(
-            ScanRecord(
-                timestamp=0.2 * i,
-                ranges=r.astype(np.float32),
-                angle_min=float(_ANGLES[0]),
-                angle_increment=float(_ANGLES[1] - _ANGLES[0]),
-                range_min=0.05,
-                range_max=_RANGE_MAX,
-                odom_pose=SE2(float(o[0]), float(o[1]), float(o[2])),
-            )
+            scan_record(0.2 * i, r, _ANGLES, odom_pose, range_min=0.05, range_max=_RANGE_MAX)
         )
     return recs, truth
 

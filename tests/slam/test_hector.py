@@ -15,7 +15,7 @@ from PIL import Image
 
 from roverlab.geometry import SE2
 from roverlab.raycast import Scene, cast_2d
-from roverlab.slam.data import ScanRecord, evaluate, iter_log, read_relations
+from roverlab.slam.data import evaluate, iter_log, read_relations
 from roverlab.slam.hector import (
     NODE_PARAMETERS,
     HectorInputError,
@@ -31,6 +31,7 @@ from roverlab.slam.hector import (
     prob_to_log_odds,
     run_log,
 )
+from tests.slam.synthetic import scan_record
 
 DATA = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "radish"
 
@@ -592,15 +593,14 @@ def test_run_log_reports_robot_poses_with_a_mounted_laser() -> None:
         ranges = ranges + rng.normal(0.0, 0.01, ranges.shape)
         odom = SE2(*pose)  # odometry is not used by default
         records.append(
-            ScanRecord(
+            scan_record(
                 100.0 + 0.1 * k,
-                ranges.astype(np.float32),
-                float(BEAMS[0]),
-                float(BEAMS[1] - BEAMS[0]),
-                0.0,
-                RANGE_MAX,
+                ranges,
+                BEAMS,
                 odom,
-                offset,
+                range_min=0.0,
+                range_max=RANGE_MAX,
+                laser_offset=offset,
             )
         )
     poses, grid, trajectory = run_log(records)
