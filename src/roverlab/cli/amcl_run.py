@@ -17,6 +17,7 @@ from roverlab.cli.log_input import (
     FirstOption,
     LogArgument,
     LoggedOdometryOption,
+    LogSource,
     OdomFrameOption,
     OdomTopicOption,
     ParamOption,
@@ -24,8 +25,6 @@ from roverlab.cli.log_input import (
     TfTopicOption,
     parse_params,
     progress,
-    read_log,
-    reversing_note,
 )
 from roverlab.geometry import SE2
 from roverlab.localization.amcl import (
@@ -38,7 +37,6 @@ from roverlab.localization.amcl import (
     map_for_amcl,
 )
 from roverlab.maps import OccupancyMap, load_map, occupancy_to_image
-from roverlab.slam.data.reversing import ReversingRepair
 from roverlab.slam.data.trajectory import read_tum, write_tum
 
 __all__ = ["app", "run"]
@@ -175,22 +173,12 @@ def run(
     amcl = Amcl(params, amcl_map, rng=np.random.default_rng(seed), initial_pose=pose,
                 global_start=global_start)  # fmt: skip
     started = time.monotonic()
-    reversing = None if logged_odometry else ReversingRepair()
-    records = read_log(
-        log,
-        scan_topic=scan_topic,
-        odom_topic=odom_topic,
-        tf_topic=tf_topic,
-        odom_frame=odom_frame,
-        base_frame=base_frame,
-        first=first,
-        error=AmclError,
-        reversing=reversing,
-    )
+    records, note = LogSource(
+        log, scan_topic, odom_topic, tf_topic, odom_frame, base_frame, first, logged_odometry
+    ).read(AmclError)
     read_s = time.monotonic() - started
     n = len(records)
     typer.echo(f"{n} scans from {log}; start: {source}", err=True)
-    note = reversing_note(reversing)
     if note is not None:
         typer.echo(note, err=True)
     snaps = sorted({-1, n // 3, (2 * n) // 3, n - 1})

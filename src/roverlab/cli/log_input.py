@@ -1,11 +1,12 @@
 """What the offline log commands share (``slam run``, ``amcl run``): reading a laser log
-with the bag options, a progress bar over its scans, and ``--param name:=value`` lists."""
+with the bag options (:class:`LogSource`), a progress bar over its scans, and
+``--param name:=value`` lists."""
 
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, NamedTuple
 
 import typer
 import yaml
@@ -27,6 +28,7 @@ __all__ = [
     "BaseFrameOption",
     "FirstOption",
     "LogArgument",
+    "LogSource",
     "LoggedOdometryOption",
     "OdomFrameOption",
     "OdomTopicOption",
@@ -35,7 +37,6 @@ __all__ = [
     "TfTopicOption",
     "parse_params",
     "progress",
-    "read_log",
     "reversing_note",
 ]
 
@@ -126,36 +127,40 @@ def parse_params(
     return out
 
 
-def read_log(
-    log: Path,
-    *,
-    scan_topic: str,
-    odom_topic: str,
-    tf_topic: str,
-    odom_frame: str,
-    base_frame: str | None,
-    first: int | None,
-    error: Callable[[str], RoverlabError],
-    reversing: ReversingRepair | None = None,
-) -> LaserLog:
-    """Load a CARMEN log or a bag (with the bag options), keeping the ``first`` scans;
-    ``reversing`` repairs a CARMEN log's steps that went forward while reversing.
+class LogSource(NamedTuple):
+    """A log and the options of reading it, as every log command takes them."""
 
-    Raises:
-        LogError: the log cannot be read.
-        RoverlabError: (``error(message)``) ``first`` below 2.
-    """
-    if first is not None and first < 2:
-        raise error(f"--first must be at least 2, got {first}")
-    if log.suffix in (".clf", ".gz", ".bz2"):
-        records = load_log(log, reversing=reversing)
-    else:
-        records = load_log(
-            log,
-            scan_topic=scan_topic,
-            odom_topic=odom_topic or None,
-            tf_topic=tf_topic,
-            odom_frame=odom_frame,
-            base_frame=base_frame,
-        )
-    return records[:first] if first is not None else records
+    log: Path
+    scan_topic: str
+    odom_topic: str
+    tf_topic: str
+    odom_frame: str
+    base_frame: str | None
+    first: int | None
+    logged_odometry: bool
+
+    def read(self, error: Callable[[str], RoverlabError]) -> tuple[LaserLog, str | None]:
+        """Load a CARMEN log or a bag (with the bag options), keeping the ``first`` scans;
+        unless ``logged_odometry``, a CARMEN log's steps that went forward while reversing
+        are repaired. Also returns :func:`reversing_note` of the repair.
+
+        Raises:
+            LogError: the log cannot be read.
+            RoverlabError: (``error(message)``) ``first`` below 2.
+        """
+        first = self.first
+        if first is not None and first < 2:
+            raise error(f"--first must be at least 2, got {first}")
+        reversing = None if self.logged_odometry else ReversingRepair()
+        if self.log.suffix in (".clf", ".gz", ".bz2"):
+            records = load_log(self.log, reversing=reversing)
+        else:
+            records = load_log(
+                self.log,
+                scan_topic=self.scan_topic,
+                odom_topic=self.odom_topic or None,
+                tf_topic=self.tf_topic,
+                odom_frame=self.odom_frame,
+                base_frame=self.base_frame,
+            )
+        return (records[:first] if first is not None else records), reversing_note(reversing)

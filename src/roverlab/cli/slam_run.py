@@ -15,6 +15,7 @@ from roverlab.cli.log_input import (
     FirstOption,
     LogArgument,
     LoggedOdometryOption,
+    LogSource,
     OdomFrameOption,
     OdomTopicOption,
     ParamOption,
@@ -22,14 +23,11 @@ from roverlab.cli.log_input import (
     TfTopicOption,
     parse_params,
     progress,
-    read_log,
-    reversing_note,
 )
 from roverlab.maps import save_map
 from roverlab.maps.plot import write_map_png
 from roverlab.slam.data.errors import SlamError
 from roverlab.slam.data.logs import LaserLog
-from roverlab.slam.data.reversing import ReversingRepair
 from roverlab.slam.data.trajectory import Trajectory, write_tum
 from roverlab.slam.gmapping import GMapping, GMappingParams
 from roverlab.slam.graph import GraphParams, GraphSLAM
@@ -174,20 +172,10 @@ def run(
     else:
         GraphParams.from_ros(params)
     started = time.monotonic()
-    reversing = None if logged_odometry else ReversingRepair()
-    records = read_log(
-        log,
-        scan_topic=scan_topic,
-        odom_topic=odom_topic,
-        tf_topic=tf_topic,
-        odom_frame=odom_frame,
-        base_frame=base_frame,
-        first=first,
-        error=SlamError,
-        reversing=reversing,
-    )
+    records, note = LogSource(
+        log, scan_topic, odom_topic, tf_topic, odom_frame, base_frame, first, logged_odometry
+    ).read(SlamError)
     typer.echo(f"{len(records)} scans from {log}", err=True)
-    note = reversing_note(reversing)
     if note is not None:
         typer.echo(note, err=True)
     if method == "hector":
