@@ -8,6 +8,7 @@ the latest time at which every edge of the chain has data.
 
 from __future__ import annotations
 
+import functools
 import threading
 import time as _walltime
 from collections.abc import Callable
@@ -102,14 +103,11 @@ class Buffer(BufferCore):
     ) -> tuple[Transform3, Time]:
         """:meth:`BufferCore.lookup_transform`, first waiting up to ``timeout`` for the
         transform to become available; then the lookup's own error is raised, as tf2_ros."""
-        with self._cond:
-            try:
-                return super().lookup_transform(target_frame, source_frame, time)
-            except TransformException:
-                if _duration_ns(timeout) <= 0:
-                    raise
-            self._wait(lambda: self._why_not(target_frame, source_frame, time) is None, timeout)
-            return super().lookup_transform(target_frame, source_frame, time)
+        return self._lookup_waiting(
+            functools.partial(super().lookup_transform, target_frame, source_frame, time),
+            lambda: self._why_not(target_frame, source_frame, time) is None,
+            timeout,
+        )
 
     def lookup_transform_full(
         self,
@@ -121,14 +119,11 @@ class Buffer(BufferCore):
         timeout: Duration | float = 0.0,
     ) -> tuple[Transform3, Time]:
         args = (target_frame, target_time, source_frame, source_time, fixed_frame)
-        with self._cond:
-            try:
-                return super().lookup_transform_full(*args)
-            except TransformException:
-                if _duration_ns(timeout) <= 0:
-                    raise
-            self._wait(lambda: self._why_not_full(*args) is None, timeout)
-            return super().lookup_transform_full(*args)
+        return self._lookup_waiting(
+            functools.partial(super().lookup_transform_full, *args),
+            lambda: self._why_not_full(*args) is None,
+            timeout,
+        )
 
     def lookup_transform_msg(
         self,
@@ -257,6 +252,23 @@ class Buffer(BufferCore):
             return super().tree_as_text()
 
     # ------------------------------------------------------------------ internals
+    def _lookup_waiting(
+        self,
+        lookup: Callable[[], tuple[Transform3, Time]],
+        ready: Callable[[], bool],
+        timeout: Duration | float,
+    ) -> tuple[Transform3, Time]:
+        """``lookup()``; if it fails and ``timeout`` is positive, wait until ``ready()`` or
+        the timeout, then ``lookup()`` again (its error is the one raised)."""
+        with self._cond:
+            try:
+                return lookup()
+            except TransformException:
+                if _duration_ns(timeout) <= 0:
+                    raise
+            self._wait(ready, timeout)
+            return lookup()
+
     def _wait(self, ready: Callable[[], bool], timeout: Duration | float) -> bool:
         """Wait (lock held, released while waiting) until ``ready()`` or the timeout."""
         if ready():
