@@ -183,23 +183,13 @@ def test_robot_and_laptop_over_a_veth_pair(namespaces: Namespaces, tmp_path: Pat
         ns.robot, [ROVERLAB, *listen, *AUTH, "launch", str(launch_file), "--rate", "1"], robot_env
     )
     ns.wait_listening(ns.laptop, ROBOT_IP, 7447, timeout=90)
-    scan = ns.run(
-        ns.laptop,
-        [
-            ROVERLAB,
-            *connect,
-            *AUTH,
-            "topic",
-            "echo",
-            "/scan",
-            "--once",
-            "--no-arr",
-            "--timeout",
-            "60",
-        ],
-        laptop_env,
-        timeout=90,
-    )
+
+    def echo_once(topic: str, wait_s: int, timeout: float) -> subprocess.CompletedProcess[str]:
+        """``topic echo TOPIC --once`` on the laptop, through the robot's listener."""
+        args = ["topic", "echo", topic, "--once", "--no-arr", "--timeout", str(wait_s)]
+        return ns.run(ns.laptop, [ROVERLAB, *connect, *AUTH, *args], laptop_env, timeout=timeout)
+
+    scan = echo_once("/scan", 60, timeout=90)
     assert scan.returncode == 0, scan.stderr + (robot.stderr.read() if robot.poll() else "")
     assert _yaml_doc(scan.stdout)["header"]["frame_id"]  # type: ignore[index]
 
@@ -235,23 +225,7 @@ def test_robot_and_laptop_over_a_veth_pair(namespaces: Namespaces, tmp_path: Pat
     deadline = time.monotonic() + 120.0
     while time.monotonic() < deadline and twist < 0.4:
         time.sleep(1.0)
-        odom = ns.run(
-            ns.laptop,
-            [
-                ROVERLAB,
-                *connect,
-                *AUTH,
-                "topic",
-                "echo",
-                "/odom",
-                "--once",
-                "--no-arr",
-                "--timeout",
-                "30",
-            ],
-            laptop_env,
-            timeout=120,
-        )
+        odom = echo_once("/odom", 30, timeout=120)
         assert odom.returncode == 0, odom.stderr
         twist = _yaml_doc(odom.stdout)["twist"]["twist"]["angular"]["z"]  # type: ignore[index]
         seen.append(round(twist, 3))
@@ -260,23 +234,7 @@ def test_robot_and_laptop_over_a_veth_pair(namespaces: Namespaces, tmp_path: Pat
     assert twist == pytest.approx(0.5, abs=0.05), f"/odom's angular speeds: {seen}"
 
     # gmapping's /map (latched) crosses too
-    grid = ns.run(
-        ns.laptop,
-        [
-            ROVERLAB,
-            *connect,
-            *AUTH,
-            "topic",
-            "echo",
-            "/map",
-            "--once",
-            "--no-arr",
-            "--timeout",
-            "60",
-        ],
-        laptop_env,
-        timeout=90,
-    )
+    grid = echo_once("/map", 60, timeout=90)
     assert grid.returncode == 0, grid.stderr
     info = _yaml_doc(grid.stdout)["info"]
     assert info["width"] > 0 and info["resolution"] == pytest.approx(0.05)  # type: ignore[index]

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tests.cli.test_amcl_run import _reversing_log
+from tests.cli.test_amcl_run import _reversing_log, _translational_error
 
 DATA = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "radish"
 
@@ -28,13 +28,7 @@ def test_hector_on_an_intel_slice_writes_map_trajectory_and_scores(tmp_path: Pat
         assert (out / name).is_file()
     lines = (out / "trajectory.tum").read_text().splitlines()
     assert len(lines) == 1500 and lines[0].split()[0] == "976052857.337530"
-    e = subprocess.run(
-        [sys.executable, "-m", "roverlab.cli", "slam", "eval", str(out / "trajectory.tum"),
-         str(DATA / "intel.relations")],
-        capture_output=True, text=True, timeout=120,
-    )  # fmt: skip
-    assert e.returncode == 0, e.stderr
-    trans = float(e.stdout.split("translational error:")[1].split("+-")[0])
+    trans = _translational_error(out / "trajectory.tum", DATA / "intel.relations")
     assert trans < 0.05  # the slice's relations (the full log scores 0.021 m)
 
 
@@ -65,13 +59,7 @@ def test_gmapping_on_an_intel_slice_is_seeded_and_scores(tmp_path: Path) -> None
     lines = a.splitlines()
     assert len(lines) == 700 and lines[0].split()[0] == "976052857.337530"
     assert (tmp_path / "a" / "map.pgm").is_file() and (tmp_path / "a" / "map.png").is_file()
-    e = subprocess.run(
-        [sys.executable, "-m", "roverlab.cli", "slam", "eval",
-         str(tmp_path / "a" / "trajectory.tum"), str(DATA / "intel.relations")],
-        capture_output=True, text=True, timeout=120,
-    )  # fmt: skip
-    assert e.returncode == 0, e.stderr
-    trans = float(e.stdout.split("translational error:")[1].split("+-")[0])
+    trans = _translational_error(tmp_path / "a" / "trajectory.tum", DATA / "intel.relations")
     assert trans < 0.08
 
 
@@ -139,13 +127,7 @@ def test_graph_on_an_intel_slice_scores(tmp_path: Path) -> None:
     assert r.returncode == 0, r.stderr
     assert "graph: " in r.stderr and "keyframes" in r.stderr
     assert len((out / "trajectory.tum").read_text().splitlines()) == 1000
-    e = subprocess.run(
-        [sys.executable, "-m", "roverlab.cli", "slam", "eval", str(out / "trajectory.tum"),
-         str(DATA / "intel.relations")],
-        capture_output=True, text=True, timeout=120,
-    )  # fmt: skip
-    assert e.returncode == 0, e.stderr
-    assert float(e.stdout.split("translational error:")[1].split("+-")[0]) < 0.05
+    assert _translational_error(out / "trajectory.tum", DATA / "intel.relations") < 0.05
 
 
 def test_graph_parameter_errors_come_before_reading_the_log(tmp_path: Path) -> None:
