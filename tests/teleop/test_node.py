@@ -22,8 +22,7 @@ from roverlab.teleop import (
     command_to_twist,
     vels,
 )
-
-Fields = tuple[float, float, float, float]
+from tests.teleop.twists import IQJJ_STOP_T, ZERO, Fields
 
 
 class ListKeys:
@@ -58,9 +57,6 @@ class Recorder:
         return out
 
 
-ZERO: Fields = (0.0, 0.0, 0.0, 0.0)
-
-
 def test_keyboard_node_loop_publishes_each_key_then_zero() -> None:
     ctx = Context()
     rec = Recorder(ctx)
@@ -71,12 +67,7 @@ def test_keyboard_node_loop_publishes_each_key_then_zero() -> None:
     keys = ListKeys(["i", "q", "J", "j", "k", "t", CTRL_C, "i"])
     node.run(keys, lines.append)
     assert rec.fields() == [
-        (0.4, 0.0, 0.0, 0.0),
-        (0.4 * 1.1, 0.0, 0.0, 0.0),
-        (0.0, 0.4 * 1.1, 0.0, 0.0),
-        (0.0, 0.0, 0.0, 0.8 * 1.1),
-        ZERO,
-        (0.0, 0.0, 0.4 * 1.1, 0.0),
+        *IQJJ_STOP_T,
         ZERO,  # the finally: after Ctrl-C (which itself publishes nothing)
     ]
     assert keys.keys == ["i"]  # nothing read after Ctrl-C

@@ -24,11 +24,9 @@ from roverlab.core import Context
 from roverlab.core.transport.daemon import connect_context
 from roverlab.msgs import Twist
 from roverlab.teleop import CTRL_C, SmoothTeleop
+from tests.teleop.twists import IQJJ_STOP_T, ZERO, Fields
 
 pytestmark = pytest.mark.zenoh
-
-Fields = tuple[float, float, float, float]
-ZERO: Fields = (0.0, 0.0, 0.0, 0.0)
 
 
 class Receiver:
@@ -181,14 +179,7 @@ def test_keyboard_keys_in_twists_out_terminal_restored(
     start = _synchronise(teleop, receiver)
 
     teleop.type("iqJj t")  # typed faster than they are handled: none may be lost
-    expected = [
-        (0.4, 0.0, 0.0, 0.0),
-        (0.4 * 1.1, 0.0, 0.0, 0.0),
-        (0.0, 0.4 * 1.1, 0.0, 0.0),
-        (0.0, 0.0, 0.0, 0.8 * 1.1),
-        ZERO,
-        (0.0, 0.0, 0.4 * 1.1, 0.0),
-    ]
+    expected = IQJJ_STOP_T
     assert receiver.wait_for(lambda m: len(m) >= start + len(expected)), receiver.msgs
     assert receiver.msgs[start:] == expected
 
