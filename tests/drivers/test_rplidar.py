@@ -11,7 +11,14 @@ import pytest
 
 from roverlab.core import Context
 from roverlab.drivers.errors import DeviceError, DriverError
-from roverlab.drivers.rplidar import NODE_DTYPE, NodeDecoder, Revolutions, build_scan, encode_nodes
+from roverlab.drivers.rplidar import (
+    NODE_DTYPE,
+    NodeDecoder,
+    Revolutions,
+    ScanData,
+    build_scan,
+    encode_nodes,
+)
 from roverlab.drivers.rplidar.node import RplidarNode
 from roverlab.drivers.rplidar.protocol import (
     encode_descriptor,
@@ -47,6 +54,19 @@ def revolution(n: int = 200) -> np.ndarray:
     return nodes
 
 
+def a1_scan(*, angle_compensate: bool, inverted: bool) -> ScanData | None:
+    """:func:`build_scan` of one :func:`revolution` at the A1's pace (500 us a sample,
+    10 Hz, 12 m)."""
+    return build_scan(
+        revolution(),
+        angle_compensate=angle_compensate,
+        inverted=inverted,
+        us_per_sample=500,
+        scan_frequency_hz=10,
+        max_distance_m=12,
+    )
+
+
 def test_requests_descriptors_and_info() -> None:
     assert request(0x20) == b"\xa5\x20"
     # SET_MOTOR_PWM 600: size 2, payload 58 02, checksum = xor of all bytes
@@ -76,14 +96,7 @@ def test_decoder_any_chunking_and_garbage() -> None:
 
 
 def test_scan_without_angle_compensation() -> None:
-    scan = build_scan(
-        revolution(),
-        angle_compensate=False,
-        inverted=False,
-        us_per_sample=500,
-        scan_frequency_hz=10,
-        max_distance_m=12,
-    )
+    scan = a1_scan(angle_compensate=False, inverted=False)
     assert scan is not None and len(scan.ranges) == 200
     assert scan.angle_max == pytest.approx(math.pi)
     assert scan.angle_min == pytest.approx(math.pi - math.radians(358.2), abs=1e-4)
@@ -93,26 +106,12 @@ def test_scan_without_angle_compensation() -> None:
     assert np.allclose(scan.ranges[finite], want[finite], atol=1e-3)
     assert np.isinf(scan.ranges[~finite]).all() and (~finite).sum() == 2
     assert (scan.intensities == 47).all() and scan.range_min == 0.15
-    flipped = build_scan(
-        revolution(),
-        angle_compensate=False,
-        inverted=True,
-        us_per_sample=500,
-        scan_frequency_hz=10,
-        max_distance_m=12,
-    )
+    flipped = a1_scan(angle_compensate=False, inverted=True)
     assert flipped is not None and np.array_equal(flipped.ranges, scan.ranges[::-1])
 
 
 def test_scan_with_angle_compensation() -> None:
-    scan = build_scan(
-        revolution(),
-        angle_compensate=True,
-        inverted=False,
-        us_per_sample=500,
-        scan_frequency_hz=10,
-        max_distance_m=12,
-    )
+    scan = a1_scan(angle_compensate=True, inverted=False)
     assert scan is not None
     # points_per_circle 200 -> multiple 200/360 + 1 -> 560 bins over [-pi, pi]
     assert len(scan.ranges) == 560
