@@ -9,7 +9,7 @@ import threading
 import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, replace
-from typing import Any
+from typing import Annotated, Any
 
 import typer
 
@@ -29,6 +29,7 @@ from roverlab.errors import RoverlabError
 __all__ = [
     "FOLLOWER_CLOCKS",
     "Connection",
+    "HostOption",
     "NetworkOptions",
     "StartGuard",
     "choose_expose",
@@ -42,6 +43,11 @@ __all__ = [
 
 #: ``--clock`` of commands that join a running system (``roverlab run``, ``patrol``).
 FOLLOWER_CLOCKS = ("auto", "wall", "external")
+
+#: ``--host`` of the commands that serve a browser or Foxglove (default "127.0.0.1").
+HostOption = Annotated[
+    str, typer.Option("--host", help="Address to bind; non-loopback needs a token.")
+]
 
 _SETTLE_S = 0.3
 _LINK_WAIT_S = 2.0

@@ -9,7 +9,7 @@ from typing import Annotated
 
 import typer
 
-from roverlab.cli.common import Connection, network_options, stop_on_signals
+from roverlab.cli.common import Connection, HostOption, network_options, stop_on_signals
 from roverlab.foxglove.bridge import FoxgloveBridge, FoxgloveError
 from roverlab.foxglove.proxy import TokenRelay
 from roverlab.viz.server import is_loopback
@@ -19,9 +19,7 @@ __all__ = ["foxglove"]
 
 def foxglove(
     ctx: typer.Context,
-    host: Annotated[
-        str, typer.Option("--host", help="Address to bind; non-loopback needs a token.")
-    ] = "127.0.0.1",
+    host: HostOption = "127.0.0.1",
     port: Annotated[int, typer.Option("--port", help="TCP port (Foxglove's default 8765).")] = 8765,
     token: Annotated[
         str | None,

@@ -11,13 +11,19 @@ from typing import Annotated
 
 import typer
 
-from roverlab.cli.common import Connection, network_options
+from roverlab.cli.common import Connection, HostOption, network_options
 from roverlab.viz.config import DashboardConfig, default_config, load_config
 from roverlab.viz.errors import DashboardError
 from roverlab.viz.launcher import image_view_config
 from roverlab.viz.server import DashboardServer
 
 __all__ = ["dashboard", "image_view", "load_dashboard_config"]
+
+# the options of both pages (dashboard, image_view) besides --host
+PortOption = Annotated[int, typer.Option("--port", help="TCP port to serve on.")]
+TokenOption = Annotated[
+    str | None, typer.Option("--token", help="Access token (made up for non-loopback).")
+]
 
 
 def load_dashboard_config(path: Path | None, fixed_frame: str | None) -> DashboardConfig | None:
@@ -40,10 +46,8 @@ def load_dashboard_config(path: Path | None, fixed_frame: str | None) -> Dashboa
 
 def dashboard(
     ctx: typer.Context,
-    host: Annotated[
-        str, typer.Option("--host", help="Address to bind; non-loopback needs a token.")
-    ] = "127.0.0.1",
-    port: Annotated[int, typer.Option("--port", help="TCP port to serve on.")] = 8080,
+    host: HostOption = "127.0.0.1",
+    port: PortOption = 8080,
     rviz: Annotated[
         Path | None,
         typer.Option(
@@ -52,9 +56,7 @@ def dashboard(
             help="Display config to load: an rviz .rviz file or a saved dashboard .json.",
         ),
     ] = None,
-    token: Annotated[
-        str | None, typer.Option("--token", help="Access token (made up for non-loopback).")
-    ] = None,
+    token: TokenOption = None,
     fixed_frame: Annotated[
         str | None,
         typer.Option("--fixed-frame", "-f", help="Fixed frame (overrides the config's)."),
@@ -117,13 +119,9 @@ def image_view(
             "/usb_cam/image_raw; omitted: pick one in the page."
         ),
     ] = None,
-    host: Annotated[
-        str, typer.Option("--host", help="Address to bind; non-loopback needs a token.")
-    ] = "127.0.0.1",
-    port: Annotated[int, typer.Option("--port", help="TCP port to serve on.")] = 8080,
-    token: Annotated[
-        str | None, typer.Option("--token", help="Access token (made up for non-loopback).")
-    ] = None,
+    host: HostOption = "127.0.0.1",
+    port: PortOption = 8080,
+    token: TokenOption = None,
 ) -> None:
     """rqt_image_view: the dashboard with its image panel on TOPIC."""
     _serve(ctx, host, port, token, image_view_config(topic), None, Path("."))
