@@ -126,24 +126,30 @@ def _free_line(occupied: np.ndarray, origin: tuple[float, float]) -> Callable[..
     return free
 
 
-class TourDriver(Node):
-    """Drives the tour's waypoints on the ground-truth pose (turn, then go), forwards then
-    back, again and again."""
+class GroundTruthDriver(Node):
+    """Drives to ``waypoints[index]`` on ``/ground_truth/state`` (turn, then go), then to
+    the next one; a subclass says when to hold still and which waypoint is current."""
 
-    def __init__(self, context: Context, waypoints: list[tuple[float, float]]) -> None:
-        super().__init__("tour_driver", context=context)
-        self.waypoints = waypoints + waypoints[::-1]
+    def __init__(self, name: str, context: Context, waypoints: list[tuple[float, float]]) -> None:
+        super().__init__(name, context=context)
+        self.waypoints = waypoints
         self.index = 0
-        self.enabled = True
         self.cmd = self.create_publisher(Twist, "/cmd_vel", 1)
         self.create_subscription(mc.Odometry, "/ground_truth/state", self._on_pose, 1)
 
+    def holding(self) -> bool:
+        """Whether to publish a zero Twist instead of driving."""
+        return False
+
+    def waypoint(self) -> tuple[float, float]:
+        return self.waypoints[self.index]
+
     def _on_pose(self, msg: Any) -> None:
-        if not self.enabled:
+        if self.holding():
             self.cmd.publish(Twist())
             return
         x, y, yaw = xytheta_from_pose(msg.pose.pose)
-        gx, gy = self.waypoints[self.index % len(self.waypoints)]
+        gx, gy = self.waypoint()
         dist = math.hypot(gx - x, gy - y)
         if dist < 0.08:
             self.index += 1
@@ -152,6 +158,20 @@ class TourDriver(Node):
         w = max(-0.6, min(0.6, 2.0 * err))
         v = 0.0 if abs(err) > 0.25 else min(0.3, 1.5 * dist)
         self.cmd.publish(Twist(linear_x=v, angular_z=w))
+
+
+class TourDriver(GroundTruthDriver):
+    """Drives the tour's waypoints forwards then back, again and again, until disabled."""
+
+    def __init__(self, context: Context, waypoints: list[tuple[float, float]]) -> None:
+        super().__init__("tour_driver", context, waypoints + waypoints[::-1])
+        self.enabled = True
+
+    def holding(self) -> bool:
+        return not self.enabled
+
+    def waypoint(self) -> tuple[float, float]:
+        return self.waypoints[self.index % len(self.waypoints)]
 
 
 # --------------------------------------------------------------------------- one drive

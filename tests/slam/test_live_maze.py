@@ -23,11 +23,11 @@ from typing import Any
 
 import numpy as np
 import pytest
+from benchmarks.amcl import GroundTruthDriver
 
-from roverlab.core import Context, Node
-from roverlab.geometry import SE2, wrap_angle
+from roverlab.core import Context
+from roverlab.geometry import SE2
 from roverlab.launch import build_launch
-from roverlab.msgs import Twist, xytheta_from_pose
 from roverlab.msgs import classes as mc
 from roverlab.sim.app import Simulation
 from roverlab.slam.data.mapquality import (
@@ -115,38 +115,22 @@ def maze_tour(
     return tour
 
 
-class WaypointDriver(Node):
+class WaypointDriver(GroundTruthDriver):
     """Drives to each waypoint in turn on the ground-truth pose (turn, then go), after
     standing still for ``start_s`` (the SLAM map frame is the pose at its first scan)."""
 
     def __init__(
         self, context: Context, waypoints: list[tuple[float, float]], start_s: float = 1.0
     ) -> None:
-        super().__init__("waypoint_driver", context=context)
+        super().__init__("waypoint_driver", context, list(waypoints))
         self.start_ns = round(start_s * 1e9)
-        self.waypoints = list(waypoints)
-        self.index = 0
-        self.cmd = self.create_publisher(Twist, "/cmd_vel", 1)
-        self.create_subscription(mc.Odometry, "/ground_truth/state", self._on_pose, 1)
 
     @property
     def done(self) -> bool:
         return self.index >= len(self.waypoints)
 
-    def _on_pose(self, msg: Any) -> None:
-        if self.done or self.get_clock().now_ns() < self.start_ns:
-            self.cmd.publish(Twist())
-            return
-        x, y, yaw = xytheta_from_pose(msg.pose.pose)
-        gx, gy = self.waypoints[self.index]
-        dist = math.hypot(gx - x, gy - y)
-        if dist < 0.08:
-            self.index += 1
-            return
-        err = float(wrap_angle(math.atan2(gy - y, gx - x) - yaw))
-        w = max(-0.6, min(0.6, 2.0 * err))
-        v = 0.0 if abs(err) > 0.25 else min(0.3, 1.5 * dist)
-        self.cmd.publish(Twist(linear_x=v, angular_z=w))
+    def holding(self) -> bool:
+        return self.done or self.get_clock().now_ns() < self.start_ns
 
 
 # --------------------------------------------------------------------------- one run
