@@ -109,7 +109,7 @@ def maze_tour(free: Callable[[float, float, float, float], bool]) -> list[tuple[
     return tour
 
 
-def _free_line(occupied: np.ndarray, origin: tuple[float, float]) -> Callable[..., bool]:
+def free_line(occupied: np.ndarray, origin: tuple[float, float]) -> Callable[..., bool]:
     def free(x0: float, y0: float, x1: float, y1: float) -> bool:
         t = np.linspace(0.0, 1.0, 64)
         nx, ny = -(y1 - y0), x1 - x0
@@ -254,7 +254,7 @@ def drive(
         sim.simulator.drive = replace(sim.simulator.drive, odometry_source="encoder")
     z = float(sim.config.lidars[0].mount.translation[2])
     gt = ground_truth(sim.world_model, resolution=RESOLUTION_M, z_m=max(z, 0.01))
-    tour = maze_tour(_free_line(gt.occupied, gt.origin_xy))
+    tour = maze_tour(free_line(gt.occupied, gt.origin_xy))
     MapServer(ctx, yaml_path=map_yaml)
     overrides = {"seed": seed, **(params or {})}
     node = AmclNode(ctx, parameter_overrides=overrides)
@@ -343,7 +343,7 @@ def make_gmapping_fixture() -> Path:
     sim = Simulation(context=ctx, world="maze", robot="mybot", cameras=False, seed=0)
     z = float(sim.config.lidars[0].mount.translation[2])
     gt = ground_truth(sim.world_model, resolution=RESOLUTION_M, z_m=max(z, 0.01))
-    tour = maze_tour(_free_line(gt.occupied, gt.origin_xy))
+    tour = maze_tour(free_line(gt.occupied, gt.origin_xy))
     SlamGMapping(ctx, parameter_overrides={"base_frame": "base_footprint"})
     driver = TourDriver(ctx, tour)
     ctx.spin_until_condition(lambda: driver.index >= len(tour), timeout_sec=900.0)

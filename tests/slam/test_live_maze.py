@@ -14,16 +14,14 @@ The default run drives the first part of the tour (a CI-sized run); the whole to
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import pytest
-from benchmarks.amcl import GroundTruthDriver
+from benchmarks.amcl import MAZE_CELLS, GroundTruthDriver, free_line, maze_tour
 
 from roverlab.core import Context
 from roverlab.geometry import SE2
@@ -41,8 +39,6 @@ from roverlab.slam.data.mapquality import (
 from roverlab.slam.graph.node import SlamToolbox
 
 FIXTURES = Path(__file__).parent / "fixtures"
-MAZE_CELL_M = 1.6  # the maze's cell pitch: 5 x 5 cells centred on the spawn
-MAZE_CELLS = 5
 
 
 @dataclass(frozen=True)
@@ -70,51 +66,6 @@ METHODS: dict[str, Method] = {
 
 
 # --------------------------------------------------------------------------- the route
-def maze_tour(
-    gt: GroundTruth, start: tuple[float, float] = (0.0, 0.0)
-) -> list[tuple[float, float]]:
-    """Cell centres of a depth-first tour of the maze from ``start`` (backtracking included).
-
-    Two neighbouring cells are connected when the ground truth is free along the straight
-    line between their centres, with 0.2 m of clearance either side.
-    """
-    half = MAZE_CELLS // 2
-    cells = [(i, j) for i in range(-half, half + 1) for j in range(-half, half + 1)]
-
-    def centre(c: tuple[int, int]) -> tuple[float, float]:
-        return start[0] + c[0] * MAZE_CELL_M, start[1] + c[1] * MAZE_CELL_M
-
-    def free(a: tuple[int, int], b: tuple[int, int]) -> bool:
-        (x0, y0), (x1, y1) = centre(a), centre(b)
-        t = np.linspace(0.0, 1.0, 64)
-        nx, ny = -(y1 - y0), x1 - x0
-        norm = math.hypot(nx, ny)
-        for off in (-0.2, 0.0, 0.2):
-            xs = x0 + t * (x1 - x0) + off * nx / norm
-            ys = y0 + t * (y1 - y0) + off * ny / norm
-            col = np.floor((xs - gt.origin_xy[0]) / gt.resolution).astype(int)
-            row = np.floor((ys - gt.origin_xy[1]) / gt.resolution).astype(int)
-            if gt.occupied[row, col].any():
-                return False
-        return True
-
-    seen = {(0, 0)}
-    tour = [centre((0, 0))]
-
-    def visit(c: tuple[int, int]) -> None:
-        for d in ((1, 0), (0, 1), (-1, 0), (0, -1)):
-            n = (c[0] + d[0], c[1] + d[1])
-            if n in cells and n not in seen and free(c, n):
-                seen.add(n)
-                tour.append(centre(n))
-                visit(n)
-                tour.append(centre(c))
-
-    visit((0, 0))
-    assert len(seen) == len(cells), "the maze tour must reach every cell"
-    return tour
-
-
 class WaypointDriver(GroundTruthDriver):
     """Drives to each waypoint in turn on the ground-truth pose (turn, then go), after
     standing still for ``start_s`` (the SLAM map frame is the pose at its first scan)."""
@@ -154,7 +105,8 @@ def run_live(
     lidar = sim.config.lidars[0]
     z = float(lidar.mount.translation[2])
     gt = ground_truth(sim.world_model, resolution=0.05, z_m=max(z, 0.01))
-    tour = maze_tour(gt)
+    tour = maze_tour(free_line(gt.occupied, gt.origin_xy))
+    assert len(set(tour)) == MAZE_CELLS**2, "the maze tour must reach every cell"
     if waypoints is not None:
         tour = tour[:waypoints]
     method.start(ctx)
