@@ -123,6 +123,7 @@ class SimulatorNode(Node):
         self._state = np.zeros(STATE_SIZE)
         self._state[S_X], self._state[S_Y] = spawn.x, spawn.y
         self._state[S_TH] = float(wrap_angle(spawn.yaw))
+        self._state_view = self._state.data  # a memoryview: entries read as Python floats
         self._executor = context.executor
         self._step_ns = round(1e9 / self.physics_rate)
         self._physics_ns = self.get_clock().now_ns()
@@ -292,7 +293,7 @@ class SimulatorNode(Node):
         ns = self._executor.now_ns  # a timer callback: the event's time
         if ns >= self._physics_ns + self._step_ns:
             self.advance()
-        st = self._state.tolist()
+        st = self._state_view
         if d.odometry_source == "encoder":
             x, y, yaw = st[S_EX], st[S_EY], st[S_ETH]
             v = 0.5 * (st[S_VL] + st[S_VR])
@@ -400,8 +401,9 @@ class SimulatorNode(Node):
         frame = sensor.frame_id
         # the state is updated in place, never replaced: a memoryview reads single
         # entries as Python floats, cheaper than the whole state's tolist()
-        state = self._state
-        rows = model.noise_rows()
+        state = self._state_view
+        rows = iter(model.take_rows())
+        take_rows = model.take_rows
         advance, nxt, sin, cos = self.advance, next, math.sin, math.cos
         physics, physics_args, slip_block = self._advance, self._physics_args, self._slip_block
         driven = self.drive is not None
@@ -420,16 +422,19 @@ class SimulatorNode(Node):
                     self._noise_pos = physics(*physics_args, self._noise, self._noise_pos, 1)
                 else:
                     advance()
-            st = state.tolist()
-            v, w = st[S_V], st[S_W]
-            n = nxt(rows)
-            half = 0.5 * st[S_TH]
+            nonlocal rows
+            n = nxt(rows, None)
+            if n is None:
+                rows = iter(take_rows())
+                n = nxt(rows)
+            v, w = state[S_V], state[S_W]
+            half = 0.5 * state[S_TH]
             sec, nsec = divmod(now, 1_000_000_000)
             publish(
                 imu(
                     sec, nsec, frame, 0.0, 0.0, sin(half), cos(half), cov,
                     n[0], n[1], w + n[2], cov,
-                    st[S_DV] + n[3], v * w + n[4], n[5], cov,
+                    state[S_DV] + n[3], v * w + n[4], n[5], cov,
                 )
             )  # fmt: skip
 
