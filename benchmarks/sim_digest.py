@@ -20,16 +20,25 @@ from __future__ import annotations
 
 import argparse
 import hashlib
+from pathlib import Path
 from typing import Any
 
+import roverlab
 from roverlab.core import Context
 from roverlab.msgs import Twist, serialize
 from roverlab.sim.app import Simulation
-from roverlab.sim.node import SpawnPose
 
-SPAWNS = {"maze": SpawnPose(0.0, 0.0, 0.0), "office": SpawnPose(0.0, 0.0, 0.0)}
+# /robot_description names the xacro file it came from: compare checkouts without it
+CHECKOUT = str(Path(roverlab.__file__).resolve().parent.parent)
 # (v, w) per second of the run, cycled
 COMMANDS = [(0.3, 0.0), (0.2, 0.6), (-0.2, 0.0), (0.5, -0.4), (0.0, 1.2), (0.4, 0.1)]
+
+
+def _bytes(msg: Any) -> bytes:
+    data = getattr(msg, "data", None)
+    if isinstance(data, str):  # a std_msgs/String: the checkout's path taken out
+        return data.replace(CHECKOUT, "<src>").encode()
+    return serialize(msg)
 
 
 def digest_run(robot: str, world: str, seconds: float, cameras: bool) -> dict[str, str]:
@@ -47,7 +56,7 @@ def digest_run(robot: str, world: str, seconds: float, cameras: bool) -> dict[st
 
         def cb(msg: Any, name: str = name) -> None:
             kept[name].append(msg)
-            hashes[name].update(serialize(msg))
+            hashes[name].update(_bytes(msg))
 
         node.create_subscription(topic.typename, name, cb, 1000)
 
@@ -66,7 +75,7 @@ def digest_run(robot: str, world: str, seconds: float, cameras: bool) -> dict[st
     for name, msgs in kept.items():
         again = hashlib.sha256()
         for m in msgs:
-            again.update(serialize(m))
+            again.update(_bytes(m))
         first = hashes[name].hexdigest()[:16]
         second = again.hexdigest()[:16]
         out[name] = f"{len(msgs):6d} {first}" + ("" if first == second else f" CHANGED {second}")

@@ -194,23 +194,23 @@ class SimulatorNode(Node):
     # ----------------------------------------------------------------- state
     @property
     def x(self) -> float:
-        return float(self._state[S_X])
+        return self._state_view[S_X]
 
     @property
     def y(self) -> float:
-        return float(self._state[S_Y])
+        return self._state_view[S_Y]
 
     @property
     def yaw(self) -> float:
-        return float(self._state[S_TH])
+        return self._state_view[S_TH]
 
     @property
     def v(self) -> float:
-        return float(self._state[S_V])
+        return self._state_view[S_V]
 
     @property
     def w(self) -> float:
-        return float(self._state[S_W])
+        return self._state_view[S_W]
 
     @property
     def contact(self) -> bool:
@@ -360,12 +360,14 @@ class SimulatorNode(Node):
             _, pitch, myaw = rpy_from_quat(mount.rotation)
             m = self._mounts[id(mount)] = (*mount.translation, myaw, pitch)
         mx, my, mz, myaw, pitch = m
-        c, s = math.cos(self.yaw), math.sin(self.yaw)
+        st = self._state_view
+        x, y, yaw = st[S_X], st[S_Y], st[S_TH]
+        c, s = math.cos(yaw), math.sin(yaw)
         return (
-            self.x + c * mx - s * my,
-            self.y + s * mx + c * my,
+            x + c * mx - s * my,
+            y + s * mx + c * my,
             mz,
-            float(wrap_angle(self.yaw + myaw)),
+            float(wrap_angle(yaw + myaw)),
             pitch,
         )
 
