@@ -126,6 +126,38 @@ def test_a_late_tf_reader_gets_the_odometry_and_wheel_transforms() -> None:
     assert wheels == {"left_wheel_link", "right_wheel_link"}
 
 
+def test_a_subscriber_cannot_change_later_messages() -> None:
+    # the IMU's and odometry's covariances are one array shared by every message: it is
+    # read-only, so a subscriber writing into it fails loudly instead of changing what
+    # later messages (and other subscribers) see
+    ctx = Context()
+    Simulation(context=ctx, world=_room(), robot="mybot", cameras=False)
+    refused: list[str] = []
+
+    def vandal(msg: Any) -> None:
+        arrays = (
+            [msg.orientation_covariance, msg.angular_velocity_covariance]
+            if hasattr(msg, "orientation_covariance")
+            else [msg.pose.covariance, msg.twist.covariance]
+        )
+        for arr in arrays:
+            try:
+                arr[0] = -1.0
+            except ValueError:
+                refused.append(type(msg).__name__)
+
+    node = ctx.create_node("vandal")
+    node.create_subscription("sensor_msgs/msg/Imu", "/imu", vandal, 10)
+    node.create_subscription("nav_msgs/msg/Odometry", "/odom", vandal, 10)
+    got = _collect(ctx, {"/imu": "sensor_msgs/msg/Imu", "/odom": "nav_msgs/msg/Odometry"})
+    ctx.spin_for(1.0)
+    assert len(refused) == 2 * (100 + 30)
+    for _, m in got["/imu"]:
+        assert not m.orientation_covariance.any() and not m.angular_velocity_covariance.any()
+    for _, m in got["/odom"]:
+        assert m.pose.covariance[0] == 1e-5 and m.twist.covariance[35] == 1e-3
+
+
 def test_the_camera_renders_only_while_someone_looks(monkeypatch: pytest.MonkeyPatch) -> None:
     # gazebo_ros_camera's sensor is active only with subscribers: no frame is rendered
     # while nobody reads /image_raw or /camera_info, a reader that joins gets 30 Hz

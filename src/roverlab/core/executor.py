@@ -177,7 +177,10 @@ class Executor:
     def _report(self, fn: Callable[[], Any], err: Exception) -> None:
         self.callback_errors += 1
         if self.on_error is not None:
-            self.on_error(getattr(fn, "__self__", fn), err)
+            owner = getattr(fn, "__self__", fn)
+            # a bound method of a wrapper (a timer's firing) names the wrapper's owner
+            owner = getattr(owner, "__self__", owner)
+            self.on_error(owner, err)
 
     def _spin_sim(self, limit: int) -> None:
         """The ``sim`` mode's loop without stop conditions: the hot path of simulation."""

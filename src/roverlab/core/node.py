@@ -177,8 +177,10 @@ class Subscription:
 
 
 class _TimerFire:
-    """The heap entry of one timer generation: firing it runs the timer, unless the
-    timer was cancelled or reset since (a new generation has its own entry)."""
+    """One timer generation: its bound :meth:`fire` is the heap entry's callable, and
+    firing runs the timer unless it was cancelled or reset since (a new generation has its
+    own). A bound method, not ``__call__``: the interpreter calls a bound Python method
+    without the C detour an instance's ``__call__`` takes."""
 
     __slots__ = ("__self__", "generation")
 
@@ -186,7 +188,7 @@ class _TimerFire:
         self.__self__ = timer  # lets the executor's error report name the owner
         self.generation = timer._generation
 
-    def __call__(self) -> None:
+    def fire(self) -> None:
         timer = self.__self__
         if timer.cancelled or self.generation != timer._generation:
             return
@@ -197,7 +199,7 @@ class _TimerFire:
         if nxt <= now:  # the clock jumped past whole periods: skip them, as rcl does
             nxt += ((now - nxt) // period + 1) * period
         timer._next_ns = nxt
-        entry: tuple[int, int, Callable[[], Any]] = (nxt, next(ex._seq), self)
+        entry: tuple[int, int, Callable[[], Any]] = (nxt, next(ex._seq), self.fire)
         heapq.heappush(ex._heap, entry)  # ex.call_at, inlined
         timer.callback()
 
@@ -220,7 +222,7 @@ class Timer:
 
     def _start(self, t_ns: int) -> None:
         self._next_ns = t_ns
-        self._executor.call_at(t_ns, _TimerFire(self))
+        self._executor.call_at(t_ns, _TimerFire(self).fire)
 
     def cancel(self) -> None:
         self.cancelled = True

@@ -34,6 +34,7 @@ from roverlab.description.model import Joint, JointType, RobotModel
 from roverlab.description.urdf import load_robot
 from roverlab.geometry import Transform3
 from roverlab.msgs import Header, JointState, String
+from roverlab.msgs import builders as build
 from roverlab.msgs import classes as mc
 from roverlab.tf import StaticTransformBroadcaster, TransformBroadcaster, transform_to_msg
 
@@ -154,18 +155,18 @@ class RobotStatePublisher(Node):
         half = position / 2.0
         s = math.sin(half)
         bx, by, bz, bw = ux * s, uy * s, uz * s, math.cos(half)
-        return mc.TransformStamped(
-            mc.Header(mc.Time(sec, nanosec), parent),
+        return build.transform_stamped(
+            sec,
+            nanosec,
+            parent,
             child,
-            mc.Transform(
-                mc.Vector3(tx, ty, tz),
-                mc.Quaternion(
-                    aw * bx + ax * bw + ay * bz - az * by,
-                    aw * by - ax * bz + ay * bw + az * bx,
-                    aw * bz + ax * by - ay * bx + az * bw,
-                    aw * bw - ax * bx - ay * by - az * bz,
-                ),
-            ),
+            tx,
+            ty,
+            tz,
+            aw * bx + ax * bw + ay * bz - az * by,
+            aw * by - ax * bz + ay * bw + az * bx,
+            aw * bz + ax * by - ay * bx + az * bw,
+            aw * bw - ax * bx - ay * by - az * bz,
         )
 
     def publish_fixed_transforms(self) -> None:
@@ -222,7 +223,7 @@ class RobotStatePublisher(Node):
                     if spec is None
                     else self._revolute_msg(spec, sec, nanosec, q)
                 )
-            self._tf.publisher.publish(mc.TFMessage(msgs))
+            self._tf.publisher.publish(build.tf_message(msgs))
 
 
 class JointStatePublisher(Node):

@@ -16,6 +16,7 @@ import numpy as np
 from roverlab.core import Node
 from roverlab.core.node import pausing_timer
 from roverlab.geometry import Transform3, rpy_from_quat, wrap_angle
+from roverlab.msgs import builders as build
 from roverlab.msgs import classes as mc
 from roverlab.msgs import xyz_to_pointcloud2
 from roverlab.raycast import Scene
@@ -61,10 +62,6 @@ class SpawnPose:
     yaw: float = 0.0
 
 
-# The builders below call the message classes positionally, in ROS field order: this runs
-# hundreds of times per simulated second, and keyword construction costs twice as much.
-
-
 def _stamp(ns: int) -> Any:
     sec, nsec = divmod(ns, 1_000_000_000)
     return mc.Time(sec, nsec)
@@ -75,32 +72,11 @@ def _header(ns: int, frame: str) -> Any:
 
 
 def _diag_cov(values: tuple[float, ...]) -> np.ndarray:
+    """A 6x6 diagonal covariance, flat and read-only: every odometry message shares it."""
     cov = np.zeros(36)
     cov[[0, 7, 14, 21, 28, 35]] = values
+    cov.flags.writeable = False
     return cov
-
-
-def _pose_msg(x: float, y: float, yaw: float, cov: np.ndarray) -> Any:
-    half = 0.5 * yaw
-    return mc.PoseWithCovariance(
-        mc.Pose(mc.Point(x, y, 0.0), mc.Quaternion(0.0, 0.0, math.sin(half), math.cos(half))),
-        cov,
-    )
-
-
-def _twist_msg(v: float, w: float, cov: np.ndarray) -> Any:
-    return mc.TwistWithCovariance(mc.Twist(mc.Vector3(v, 0.0, 0.0), mc.Vector3(0.0, 0.0, w)), cov)
-
-
-def _transform(ns: int, parent: str, child: str, x: float, y: float, yaw: float) -> Any:
-    half = 0.5 * yaw
-    return mc.TransformStamped(
-        _header(ns, parent),
-        child,
-        mc.Transform(
-            mc.Vector3(x, y, 0.0), mc.Quaternion(0.0, 0.0, math.sin(half), math.cos(half))
-        ),
-    )
 
 
 class SimulatorNode(Node):
@@ -147,6 +123,7 @@ class SimulatorNode(Node):
         self._state = np.zeros(STATE_SIZE)
         self._state[S_X], self._state[S_Y] = spawn.x, spawn.y
         self._state[S_TH] = float(wrap_angle(spawn.yaw))
+        self._state_view = self._state.data  # a memoryview: entries read as Python floats
         self._executor = context.executor
         self._step_ns = round(1e9 / self.physics_rate)
         self._physics_ns = self.get_clock().now_ns()
@@ -217,23 +194,23 @@ class SimulatorNode(Node):
     # ----------------------------------------------------------------- state
     @property
     def x(self) -> float:
-        return float(self._state[S_X])
+        return self._state_view[S_X]
 
     @property
     def y(self) -> float:
-        return float(self._state[S_Y])
+        return self._state_view[S_Y]
 
     @property
     def yaw(self) -> float:
-        return float(self._state[S_TH])
+        return self._state_view[S_TH]
 
     @property
     def v(self) -> float:
-        return float(self._state[S_V])
+        return self._state_view[S_V]
 
     @property
     def w(self) -> float:
-        return float(self._state[S_W])
+        return self._state_view[S_W]
 
     @property
     def contact(self) -> bool:
@@ -316,7 +293,7 @@ class SimulatorNode(Node):
         ns = self._executor.now_ns  # a timer callback: the event's time
         if ns >= self._physics_ns + self._step_ns:
             self.advance()
-        st = self._state.tolist()
+        st = self._state_view
         if d.odometry_source == "encoder":
             x, y, yaw = st[S_EX], st[S_EY], st[S_ETH]
             v = 0.5 * (st[S_VL] + st[S_VR])
@@ -327,30 +304,18 @@ class SimulatorNode(Node):
         sec, nsec = divmod(ns, 1_000_000_000)
         half = 0.5 * yaw
         qz, qw = math.sin(half), math.cos(half)
-        time, header, vec, quat = mc.Time, mc.Header, mc.Vector3, mc.Quaternion
+        frame, child = d.odometry_frame, d.robot_base_frame
         self.odom_pub.publish(
-            mc.Odometry(
-                header(time(sec, nsec), d.odometry_frame),
-                d.robot_base_frame,
-                mc.PoseWithCovariance(
-                    mc.Pose(mc.Point(x, y, 0.0), quat(0.0, 0.0, qz, qw)), self._pose_cov
-                ),
-                mc.TwistWithCovariance(
-                    mc.Twist(vec(v, 0.0, 0.0), vec(0.0, 0.0, w)), self._twist_cov
-                ),
+            build.odometry(
+                sec, nsec, frame, child, x, y, 0.0, 0.0, 0.0, qz, qw, self._pose_cov,
+                v, 0.0, 0.0, 0.0, 0.0, w, self._twist_cov,
             )
-        )
+        )  # fmt: skip
         # the transform is built only when someone reads /tf (here or in another process)
         if d.publish_odom_tf and self._tf_pub.has_listeners:
             self._tf_pub.publish(
-                mc.TFMessage(
-                    [
-                        mc.TransformStamped(
-                            header(time(sec, nsec), d.odometry_frame),
-                            d.robot_base_frame,
-                            mc.Transform(vec(x, y, 0.0), quat(0.0, 0.0, qz, qw)),
-                        )
-                    ]
+                build.tf_message(
+                    [build.transform_stamped(sec, nsec, frame, child, x, y, 0.0, 0.0, 0.0, qz, qw)]
                 )
             )
         if self.joint_pub is not None:
@@ -358,8 +323,10 @@ class SimulatorNode(Node):
             k = self._wheel_k
             values = np.array((st[S_AL], st[S_AR], st[S_VL] * k, st[S_VR] * k, 0.0, 0.0))
             self.joint_pub.publish(
-                mc.JointState(
-                    header(time(sec, nsec), ""),
+                build.joint_state(
+                    sec,
+                    nsec,
+                    "",
                     [d.left_joint, d.right_joint],
                     values[0:2],
                     values[2:4],
@@ -369,16 +336,16 @@ class SimulatorNode(Node):
 
     def _publish_ground_truth(self) -> None:
         self.advance()
-        ns = self.get_clock().now_ns()
+        sec, nsec = divmod(self._executor.now_ns, 1_000_000_000)
+        half = 0.5 * self.yaw
         zero = np.zeros(36)
         self.gt_pub.publish(
-            mc.Odometry(
-                header=_header(ns, "world"),
-                child_frame_id=self.robot.base_frame,
-                pose=_pose_msg(self.x, self.y, self.yaw, zero),
-                twist=_twist_msg(self.v, self.w, zero),
+            build.odometry(
+                sec, nsec, "world", self.robot.base_frame, self.x, self.y, 0.0,
+                0.0, 0.0, math.sin(half), math.cos(half), zero,
+                self.v, 0.0, 0.0, 0.0, 0.0, self.w, zero,
             )
-        )
+        )  # fmt: skip
 
     # ----------------------------------------------------------------- sensors
     def sensor_pose(self, mount: Transform3) -> tuple[float, float, float, float, float]:
@@ -393,12 +360,14 @@ class SimulatorNode(Node):
             _, pitch, myaw = rpy_from_quat(mount.rotation)
             m = self._mounts[id(mount)] = (*mount.translation, myaw, pitch)
         mx, my, mz, myaw, pitch = m
-        c, s = math.cos(self.yaw), math.sin(self.yaw)
+        st = self._state_view
+        x, y, yaw = st[S_X], st[S_Y], st[S_TH]
+        c, s = math.cos(yaw), math.sin(yaw)
         return (
-            self.x + c * mx - s * my,
-            self.y + s * mx + c * my,
+            x + c * mx - s * my,
+            y + s * mx + c * my,
             mz,
-            float(wrap_angle(self.yaw + myaw)),
+            float(wrap_angle(yaw + myaw)),
             pitch,
         )
 
@@ -413,20 +382,13 @@ class SimulatorNode(Node):
         def tick() -> None:
             x, y, z, yaw, _ = self.sensor_pose(sensor.mount)
             ranges = model.scan(self.scene, x, y, z, yaw)
+            sec, nsec = divmod(self._executor.now_ns, 1_000_000_000)
             pub.publish(
-                mc.LaserScan(
-                    header=_header(self.get_clock().now_ns(), sensor.frame_id),
-                    angle_min=p.min_angle,
-                    angle_max=p.max_angle,
-                    angle_increment=p.angle_increment,
-                    time_increment=0.0,
-                    scan_time=scan_time,
-                    range_min=p.range_min,
-                    range_max=p.range_max,
-                    ranges=ranges,
-                    intensities=empty,
+                build.laser_scan(
+                    sec, nsec, sensor.frame_id, p.min_angle, p.max_angle, p.angle_increment,
+                    0.0, scan_time, p.range_min, p.range_max, ranges, empty,
                 )
-            )
+            )  # fmt: skip
 
         self.create_timer(scan_time, tick)
 
@@ -434,17 +396,21 @@ class SimulatorNode(Node):
         model = ImuModel(sensor.rate, sensor.accel, rng, gaussian_noise=sensor.gaussian_noise)
         pub = self.create_publisher(mc.Imu, sensor.topic, 10)
         rate = sensor.update_rate_hz if sensor.update_rate_hz > 0 else self.physics_rate
-        cov = np.zeros(9)
+        cov = np.zeros(9)  # shared by the three fields of every message: read-only
+        cov.flags.writeable = False
 
         ex = self._executor
         frame = sensor.frame_id
-        state = self._state  # updated in place, never replaced
-        rows = model.noise_rows()
+        # the state is updated in place, never replaced: a memoryview reads single
+        # entries as Python floats, cheaper than the whole state's tolist()
+        state = self._state_view
+        rows = iter(model.take_rows())
+        take_rows = model.take_rows
         advance, nxt, sin, cos = self.advance, next, math.sin, math.cos
         physics, physics_args, slip_block = self._advance, self._physics_args, self._slip_block
         driven = self.drive is not None
         publish = pub.publish
-        imu, header, stamp, quat, vec = mc.Imu, mc.Header, mc.Time, mc.Quaternion, mc.Vector3
+        imu = build.imu
 
         step_ns = self._step_ns
 
@@ -458,22 +424,21 @@ class SimulatorNode(Node):
                     self._noise_pos = physics(*physics_args, self._noise, self._noise_pos, 1)
                 else:
                     advance()
-            st = state.tolist()
-            v, w = st[S_V], st[S_W]
-            n = nxt(rows)
-            half = 0.5 * st[S_TH]
+            nonlocal rows
+            n = nxt(rows, None)
+            if n is None:
+                rows = iter(take_rows())
+                n = nxt(rows)
+            v, w = state[S_V], state[S_W]
+            half = 0.5 * state[S_TH]
             sec, nsec = divmod(now, 1_000_000_000)
             publish(
                 imu(
-                    header(stamp(sec, nsec), frame),
-                    quat(0.0, 0.0, sin(half), cos(half)),
-                    cov,
-                    vec(n[0], n[1], w + n[2]),
-                    cov,
-                    vec(st[S_DV] + n[3], v * w + n[4], n[5]),
-                    cov,
+                    sec, nsec, frame, 0.0, 0.0, sin(half), cos(half), cov,
+                    n[0], n[1], w + n[2], cov,
+                    state[S_DV] + n[3], v * w + n[4], n[5], cov,
                 )
-            )
+            )  # fmt: skip
 
         self.create_timer(1.0 / rate, tick)
 

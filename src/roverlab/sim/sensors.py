@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import math
 import sys
-from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Any
 
@@ -190,16 +189,15 @@ class ImuModel:
         self._pos += 1
         return row
 
-    def noise_rows(self) -> Iterator[list[float]]:
-        """The noise rows :meth:`measure` would use, in the same order (it and this
-        iterator share one position): for a caller that applies them itself."""
-        while True:
-            pos = self._pos
-            if pos >= len(self._block):
-                self._refill()
-                pos = 0
-            self._pos = pos + 1
-            yield self._block[pos]
+    def take_rows(self) -> list[list[float]]:
+        """The noise rows :meth:`measure` would use next, as many as are drawn already
+        (a whole block when none is left), in order; they count as used. For a caller
+        that applies them itself: walking a list costs less than a call per row."""
+        if self._pos >= len(self._block):
+            self._refill()
+        rows = self._block[self._pos :] if self._pos else self._block
+        self._pos = len(self._block)
+        return rows
 
     def measure(
         self, yaw: float, v: float, w: float, dv_dt: float

@@ -1,0 +1,292 @@
+"""Whole stamped messages built in one call, for publishers that run hundreds of times
+per simulated second (the simulator's IMU, odometry, joint states and scans, TF).
+
+Calling a rosbags message class runs its dataclass ``__init__`` through ``type.__call__``,
+a C-to-Python call per object; an IMU message has six objects. These builders make the
+same objects with ``object.__new__`` and plain attribute stores in a single Python frame:
+about a quarter fewer instructions for a message (callgrind), and the very same result
+(same classes, same instance dicts in the same order, ``__msgtype__`` included; the tests
+compare each builder with the class constructors).
+
+Arguments are the message's leaves in field order, flattened; arrays (covariances, joint
+values, ranges) are stored as given, not copied.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+from . import classes as mc
+
+__all__ = ["imu", "joint_state", "laser_scan", "odometry", "tf_message", "transform_stamped"]
+
+# typed loosely: the objects get their fields (and ``__msgtype__``) assigned one by one
+_new: Callable[[type[Any]], Any] = object.__new__
+_Time, _TIME = mc.Time, mc.Time.__msgtype__
+_Header, _HEADER = mc.Header, mc.Header.__msgtype__
+_Vector3, _VECTOR3 = mc.Vector3, mc.Vector3.__msgtype__
+_Point, _POINT = mc.Point, mc.Point.__msgtype__
+_Quaternion, _QUATERNION = mc.Quaternion, mc.Quaternion.__msgtype__
+_Pose, _POSE = mc.Pose, mc.Pose.__msgtype__
+_PoseCov, _POSE_COV = mc.PoseWithCovariance, mc.PoseWithCovariance.__msgtype__
+_Twist, _TWIST = mc.Twist, mc.Twist.__msgtype__
+_TwistCov, _TWIST_COV = mc.TwistWithCovariance, mc.TwistWithCovariance.__msgtype__
+_Odometry, _ODOMETRY = mc.Odometry, mc.Odometry.__msgtype__
+_Imu, _IMU = mc.Imu, mc.Imu.__msgtype__
+_JointState, _JOINT_STATE = mc.JointState, mc.JointState.__msgtype__
+_LaserScan, _LASER_SCAN = mc.LaserScan, mc.LaserScan.__msgtype__
+_Transform, _TRANSFORM = mc.Transform, mc.Transform.__msgtype__
+_TransformStamped, _TRANSFORM_STAMPED = mc.TransformStamped, mc.TransformStamped.__msgtype__
+_TFMessage, _TF_MESSAGE = mc.TFMessage, mc.TFMessage.__msgtype__
+
+
+def imu(
+    sec: int,
+    nanosec: int,
+    frame_id: str,
+    qx: float,
+    qy: float,
+    qz: float,
+    qw: float,
+    orientation_covariance: Any,
+    wx: float,
+    wy: float,
+    wz: float,
+    angular_velocity_covariance: Any,
+    ax: float,
+    ay: float,
+    az: float,
+    linear_acceleration_covariance: Any,
+) -> Any:
+    """``sensor_msgs/Imu``: stamp, frame, orientation, rates, accelerations."""
+    t = _new(_Time)
+    t.sec = sec
+    t.nanosec = nanosec
+    t.__msgtype__ = _TIME
+    h = _new(_Header)
+    h.stamp = t
+    h.frame_id = frame_id
+    h.__msgtype__ = _HEADER
+    q = _new(_Quaternion)
+    q.x = qx
+    q.y = qy
+    q.z = qz
+    q.w = qw
+    q.__msgtype__ = _QUATERNION
+    w = _new(_Vector3)
+    w.x = wx
+    w.y = wy
+    w.z = wz
+    w.__msgtype__ = _VECTOR3
+    a = _new(_Vector3)
+    a.x = ax
+    a.y = ay
+    a.z = az
+    a.__msgtype__ = _VECTOR3
+    m = _new(_Imu)
+    m.header = h
+    m.orientation = q
+    m.orientation_covariance = orientation_covariance
+    m.angular_velocity = w
+    m.angular_velocity_covariance = angular_velocity_covariance
+    m.linear_acceleration = a
+    m.linear_acceleration_covariance = linear_acceleration_covariance
+    m.__msgtype__ = _IMU
+    return m
+
+
+def odometry(
+    sec: int,
+    nanosec: int,
+    frame_id: str,
+    child_frame_id: str,
+    x: float,
+    y: float,
+    z: float,
+    qx: float,
+    qy: float,
+    qz: float,
+    qw: float,
+    pose_covariance: Any,
+    vx: float,
+    vy: float,
+    vz: float,
+    wx: float,
+    wy: float,
+    wz: float,
+    twist_covariance: Any,
+) -> Any:
+    """``nav_msgs/Odometry``: stamp, frames, position, orientation, linear and angular
+    velocity, with the two covariances."""
+    t = _new(_Time)
+    t.sec = sec
+    t.nanosec = nanosec
+    t.__msgtype__ = _TIME
+    h = _new(_Header)
+    h.stamp = t
+    h.frame_id = frame_id
+    h.__msgtype__ = _HEADER
+    p = _new(_Point)
+    p.x = x
+    p.y = y
+    p.z = z
+    p.__msgtype__ = _POINT
+    q = _new(_Quaternion)
+    q.x = qx
+    q.y = qy
+    q.z = qz
+    q.w = qw
+    q.__msgtype__ = _QUATERNION
+    pose = _new(_Pose)
+    pose.position = p
+    pose.orientation = q
+    pose.__msgtype__ = _POSE
+    pc = _new(_PoseCov)
+    pc.pose = pose
+    pc.covariance = pose_covariance
+    pc.__msgtype__ = _POSE_COV
+    lin = _new(_Vector3)
+    lin.x = vx
+    lin.y = vy
+    lin.z = vz
+    lin.__msgtype__ = _VECTOR3
+    ang = _new(_Vector3)
+    ang.x = wx
+    ang.y = wy
+    ang.z = wz
+    ang.__msgtype__ = _VECTOR3
+    tw = _new(_Twist)
+    tw.linear = lin
+    tw.angular = ang
+    tw.__msgtype__ = _TWIST
+    tc = _new(_TwistCov)
+    tc.twist = tw
+    tc.covariance = twist_covariance
+    tc.__msgtype__ = _TWIST_COV
+    m = _new(_Odometry)
+    m.header = h
+    m.child_frame_id = child_frame_id
+    m.pose = pc
+    m.twist = tc
+    m.__msgtype__ = _ODOMETRY
+    return m
+
+
+def transform_stamped(
+    sec: int,
+    nanosec: int,
+    frame_id: str,
+    child_frame_id: str,
+    x: float,
+    y: float,
+    z: float,
+    qx: float,
+    qy: float,
+    qz: float,
+    qw: float,
+) -> Any:
+    """``geometry_msgs/TransformStamped``: stamp, frames, translation, rotation."""
+    t = _new(_Time)
+    t.sec = sec
+    t.nanosec = nanosec
+    t.__msgtype__ = _TIME
+    h = _new(_Header)
+    h.stamp = t
+    h.frame_id = frame_id
+    h.__msgtype__ = _HEADER
+    v = _new(_Vector3)
+    v.x = x
+    v.y = y
+    v.z = z
+    v.__msgtype__ = _VECTOR3
+    q = _new(_Quaternion)
+    q.x = qx
+    q.y = qy
+    q.z = qz
+    q.w = qw
+    q.__msgtype__ = _QUATERNION
+    tr = _new(_Transform)
+    tr.translation = v
+    tr.rotation = q
+    tr.__msgtype__ = _TRANSFORM
+    m = _new(_TransformStamped)
+    m.header = h
+    m.child_frame_id = child_frame_id
+    m.transform = tr
+    m.__msgtype__ = _TRANSFORM_STAMPED
+    return m
+
+
+def tf_message(transforms: list[Any]) -> Any:
+    """``tf2_msgs/TFMessage`` of ``transforms`` (the list itself is stored)."""
+    m = _new(_TFMessage)
+    m.transforms = transforms
+    m.__msgtype__ = _TF_MESSAGE
+    return m
+
+
+def joint_state(
+    sec: int,
+    nanosec: int,
+    frame_id: str,
+    name: list[str],
+    position: Any,
+    velocity: Any,
+    effort: Any,
+) -> Any:
+    """``sensor_msgs/JointState``: stamp, frame, names and the three value arrays."""
+    t = _new(_Time)
+    t.sec = sec
+    t.nanosec = nanosec
+    t.__msgtype__ = _TIME
+    h = _new(_Header)
+    h.stamp = t
+    h.frame_id = frame_id
+    h.__msgtype__ = _HEADER
+    m = _new(_JointState)
+    m.header = h
+    m.name = name
+    m.position = position
+    m.velocity = velocity
+    m.effort = effort
+    m.__msgtype__ = _JOINT_STATE
+    return m
+
+
+def laser_scan(
+    sec: int,
+    nanosec: int,
+    frame_id: str,
+    angle_min: float,
+    angle_max: float,
+    angle_increment: float,
+    time_increment: float,
+    scan_time: float,
+    range_min: float,
+    range_max: float,
+    ranges: Any,
+    intensities: Any,
+) -> Any:
+    """``sensor_msgs/LaserScan``: stamp, frame and the fields in ROS order."""
+    t = _new(_Time)
+    t.sec = sec
+    t.nanosec = nanosec
+    t.__msgtype__ = _TIME
+    h = _new(_Header)
+    h.stamp = t
+    h.frame_id = frame_id
+    h.__msgtype__ = _HEADER
+    m = _new(_LaserScan)
+    m.header = h
+    m.angle_min = angle_min
+    m.angle_max = angle_max
+    m.angle_increment = angle_increment
+    m.time_increment = time_increment
+    m.scan_time = scan_time
+    m.range_min = range_min
+    m.range_max = range_max
+    m.ranges = ranges
+    m.intensities = intensities
+    m.__msgtype__ = _LASER_SCAN
+    return m
