@@ -24,7 +24,9 @@ from roverlab.sim.dynamics import (
     S_X,
     S_Y,
     STATE_SIZE,
+    PhysicsPack,
     advance,
+    advance_packed,
 )
 
 SEP, DIAM = 0.18, 0.05
@@ -152,3 +154,23 @@ def test_long_step_does_not_tunnel_through_a_wall() -> None:
     st[S_X] = 1.0
     _run(st, _params(), 1, walls=obs.segments, circles=obs.circles)
     assert st[S_CONTACT] == 1.0 and st[S_X] < 2.0
+
+
+def test_packed_kernel_matches_advance() -> None:
+    """advance_packed (one float64 array for the state, parameters, dt, footprint,
+    walls, circles and noise) runs the same steps as advance, bit for bit."""
+    walls = np.array([[0.25, -1.0, 0.25, 1.0], [-1.0, 0.5, 1.0, 0.5]])
+    circles = np.array([[-0.3, -0.4, 0.05]])
+    noise = np.random.default_rng(3).standard_normal((64, 2))
+    params = _params(acc=2.0, slip=0.05)
+    st = _state(0.3, 0.4)
+    pack = PhysicsPack(st, params, 0.01, FOOTPRINT, walls, circles, noise)
+    near = np.zeros(len(walls) + len(circles), dtype=np.int64)
+    pos = ref_pos = 0
+    for steps in (1, 5, 40, 30):
+        pos = advance_packed(pack.array, near, pos, steps)
+        ref_pos = advance(st, params, 0.01, FOOTPRINT, walls, circles, near, noise, ref_pos, steps)
+        assert pos == ref_pos
+        assert pack.state.tobytes() == st.tobytes()
+    assert pack.state[S_CONTACTS] >= 1
+    assert pack.noise.tobytes() == noise.tobytes()

@@ -136,6 +136,7 @@ class RobotStatePublisher(Node):
                     (ux, uy, uz),
                 )
         self._last_published: dict[str, int] = {}
+        self._plans: dict[tuple[str, ...], list[tuple[int, str, Joint, list[Joint]]]] = {}
         self._executor = context.executor
         self.publish_fixed_transforms()
         self.create_subscription(JointState, "joint_states", self._on_joint_states, 10)
@@ -176,6 +177,18 @@ class RobotStatePublisher(Node):
         if msgs:
             self._tf_static.send_transform(msgs)
 
+    def _plan(self, names: tuple[str, ...]) -> list[tuple[int, str, Joint, list[Joint]]]:
+        """For each name of a movable joint that mimics none: its index, the joint and
+        its mimics."""
+        plan = []
+        for i, name in enumerate(names):
+            joint = self._movable.get(name)
+            if joint is not None and joint.mimic is None:
+                plan.append((i, name, joint, self._mimics.get(name, [])))
+        if len(self._plans) < 64:
+            self._plans[names] = plan
+        return plan
+
     def _on_joint_states(self, msg: mc.JointState) -> None:
         names = msg.name
         positions = msg.position
@@ -185,34 +198,45 @@ class RobotStatePublisher(Node):
                 "ignored"
             )
             return
-        stamp_ns = msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
+        stamp = msg.header.stamp
+        stamp_ns = stamp.sec * 1_000_000_000 + stamp.nanosec
         now_ns = self._executor.now_ns
-        if self.ignore_timestamp or stamp_ns == 0:
+        ignore = self.ignore_timestamp
+        if ignore or stamp_ns == 0:
             stamp_ns = now_ns
-        # ROS 1 throttling: publish when the oldest of these joints was last published at
-        # least one publish interval ago
-        last_ns = now_ns
-        for name in names:
-            t = self._last_published.get(name, 0)
-            if t < last_ns:
-                last_ns = t
-        if not (self.ignore_timestamp or stamp_ns >= last_ns + self.publish_interval.nanoseconds):
-            return
+        last_published = self._last_published
+        if not ignore:
+            # ROS 1 throttling: publish when the oldest of these joints was last published
+            # at least one publish interval ago
+            last_ns = now_ns
+            for name in names:
+                t = last_published.get(name, 0)
+                if t < last_ns:
+                    last_ns = t
+            if stamp_ns < last_ns + self.publish_interval.nanoseconds:
+                return
+        if type(positions) is np.ndarray and positions.dtype.char == "d":
+            values = positions.tolist()  # the usual case: float64 already
+        else:
+            values = np.asarray(positions, dtype=float).tolist()
+        # the movable joints these names set, worked out once per list of names
+        key = tuple(names)
+        plan = self._plans.get(key)
+        if plan is None:
+            plan = self._plan(key)
+        known = self._positions
         updated: dict[str, Joint] = {}
-        for name, position in zip(names, np.asarray(positions, dtype=float).tolist(), strict=True):
-            joint = self._movable.get(name)
-            if joint is None or joint.mimic is not None:
-                continue
-            self._positions[name] = position
+        for i, name, joint, mimics in plan:
+            known[name] = values[i]
             updated[name] = joint
-            for mimic in self._mimics.get(name, ()):
+            for mimic in mimics:
                 updated[mimic.name] = mimic
         for name in names:
-            self._last_published[name] = stamp_ns
+            last_published[name] = stamp_ns
         # transforms are built only when someone reads /tf (here or in another process)
         if updated and self._tf.publisher.has_listeners:
             sec, nanosec = divmod(stamp_ns, 1_000_000_000)
-            revolute, known = self._revolute, self._positions
+            revolute = self._revolute
             position_of = self.model.joint_position
             msgs = []
             for j in updated.values():

@@ -29,7 +29,7 @@ from roverlab.sim.collision import any_near, gather_near, polygon_hits_near
 
 F = TypeVar("F", bound=Callable[..., Any])
 
-__all__ = ["STATE_SIZE", "advance", "compiled_entry"]
+__all__ = ["STATE_SIZE", "PhysicsPack", "advance", "advance_packed", "compiled_entry"]
 
 S_X, S_Y, S_TH = 0, 1, 2
 S_VL, S_VR, S_TL, S_TR = 3, 4, 5, 6
@@ -240,6 +240,68 @@ def advance(
             state[S_CONTACTS] += 1.0
         state[S_CONTACT] = 1.0 if contact else 0.0
     return noise_pos
+
+
+# the packed arguments' header, after the state: dt, then rows and columns of the
+# footprint, the segments, the circles and the noise
+_H = STATE_SIZE
+_PARAMS = _H + 9
+
+
+@numba.njit(cache=True)
+def advance_packed(pack: np.ndarray, near: np.ndarray, noise_pos: int, steps: int) -> int:
+    """:func:`advance` with its float64 arrays and ``dt`` in one array (see
+    :class:`PhysicsPack`): the compiled entry unboxes two arrays per call, not seven."""
+    dt = pack[_H]
+    o = _PARAMS + 5
+    n, c = int(pack[_H + 1]), int(pack[_H + 2])
+    footprint = pack[o : o + n * c].reshape((n, c))
+    o += n * c
+    n, c = int(pack[_H + 3]), int(pack[_H + 4])
+    segments = pack[o : o + n * c].reshape((n, c))
+    o += n * c
+    n, c = int(pack[_H + 5]), int(pack[_H + 6])
+    circles = pack[o : o + n * c].reshape((n, c))
+    o += n * c
+    n, c = int(pack[_H + 7]), int(pack[_H + 8])
+    noise = pack[o : o + n * c].reshape((n, c))
+    return advance(
+        pack[:STATE_SIZE],
+        pack[_PARAMS : _PARAMS + 5],
+        dt,
+        footprint,
+        segments,
+        circles,
+        near,
+        noise,
+        noise_pos,
+        steps,
+    )
+
+
+class PhysicsPack:
+    """One float64 array holding :func:`advance`'s state, parameters, ``dt``, footprint,
+    segments, circles and slip noise, for :func:`advance_packed`; ``state`` and
+    ``noise`` are views into it (the state updated in place, the noise refilled in
+    place)."""
+
+    def __init__(
+        self,
+        state: np.ndarray,
+        params: np.ndarray,
+        dt: float,
+        footprint: np.ndarray,
+        segments: np.ndarray,
+        circles: np.ndarray,
+        noise: np.ndarray,
+    ) -> None:
+        parts = [np.asarray(a, dtype=np.float64) for a in (footprint, segments, circles, noise)]
+        shapes = [(a.shape[0], a.shape[1]) for a in parts]
+        head = np.array([float(dt)] + [float(v) for shape in shapes for v in shape])
+        pieces = [np.asarray(state, dtype=np.float64), head, np.asarray(params, dtype=np.float64)]
+        self.array = np.concatenate(pieces + [a.reshape(-1) for a in parts])
+        self.state = self.array[:STATE_SIZE]
+        self.noise = self.array[self.array.size - parts[3].size :].reshape(shapes[3])
 
 
 def compiled_entry(kernel: F, *args: Any) -> F:

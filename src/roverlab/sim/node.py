@@ -43,7 +43,8 @@ from roverlab.sim.dynamics import (
     S_X,
     S_Y,
     STATE_SIZE,
-    advance,
+    PhysicsPack,
+    advance_packed,
     compiled_entry,
 )
 from roverlab.sim.sensors import CameraModel, ImuModel, LidarModel
@@ -153,17 +154,17 @@ class SimulatorNode(Node):
         self._dt = self._step_ns / 1e9
         obs = self.obstacles
         self._near = np.zeros(len(obs.segments) + len(obs.circles), dtype=np.int64)
-        # the kernel's arguments that never change, then noise, its position and the steps
-        self._physics_args = (
-            self._state,
-            self._params,
-            self._dt,
-            self._footprint,
-            obs.segments,
-            obs.circles,
-            self._near,
-        )
-        self._advance = compiled_entry(advance, *self._physics_args, self._noise, 0, 0)
+        # the kernel's float64 arguments in one array (two arrays unboxed per call, not
+        # seven); the state and the noise become views into it
+        pack = PhysicsPack(
+            self._state, self._params, self._dt, self._footprint, obs.segments, obs.circles,
+            self._noise,
+        )  # fmt: skip
+        self._pack = pack.array
+        self._state = pack.state
+        self._state_view = self._state.data
+        self._noise = pack.noise
+        self._advance = compiled_entry(advance_packed, self._pack, self._near, 0, 0)
         self.tf = TransformBroadcaster(self)
         self._tf_pub = self.tf.publisher
         self._wheel_k = 2.0 / self.drive.params.wheel_diameter_m if self.drive else 0.0
@@ -234,18 +235,16 @@ class SimulatorNode(Node):
         if self.drive is None:
             return
         if self._noise_pos + steps <= self._slip_block:  # the usual case: one call
-            pos = self._advance(*self._physics_args, self._noise, self._noise_pos, steps)
-            self._noise_pos = pos
+            self._noise_pos = self._advance(self._pack, self._near, self._noise_pos, steps)
             return
-        self._noise = self._slip_rng.standard_normal((self._slip_block, 2))
+        self._noise[...] = self._slip_rng.standard_normal((self._slip_block, 2))
         self._noise_pos = 0
         while steps > 0:
             chunk = min(steps, self._slip_block - self._noise_pos)
-            pos = self._advance(*self._physics_args, self._noise, self._noise_pos, chunk)
-            self._noise_pos = pos
+            self._noise_pos = self._advance(self._pack, self._near, self._noise_pos, chunk)
             steps -= chunk
             if steps > 0:
-                self._noise = self._slip_rng.standard_normal((self._slip_block, 2))
+                self._noise[...] = self._slip_rng.standard_normal((self._slip_block, 2))
                 self._noise_pos = 0
 
     def teleport(self, x: float, y: float, yaw: float) -> None:
@@ -407,7 +406,7 @@ class SimulatorNode(Node):
         rows = iter(model.take_rows())
         take_rows = model.take_rows
         advance, nxt, sin, cos = self.advance, next, math.sin, math.cos
-        physics, physics_args, slip_block = self._advance, self._physics_args, self._slip_block
+        physics, pack, near, slip_block = self._advance, self._pack, self._near, self._slip_block
         driven = self.drive is not None
         publish = pub.publish
         imu = build.imu
@@ -421,7 +420,7 @@ class SimulatorNode(Node):
             if now >= self._physics_ns + step_ns:
                 if driven and now < self._physics_ns + 2 * step_ns and self._noise_pos < slip_block:
                     self._physics_ns += step_ns
-                    self._noise_pos = physics(*physics_args, self._noise, self._noise_pos, 1)
+                    self._noise_pos = physics(pack, near, self._noise_pos, 1)
                 else:
                     advance()
             nonlocal rows
