@@ -37,7 +37,6 @@ __all__ = [
     "TfTopicOption",
     "parse_params",
     "progress",
-    "reversing_note",
 ]
 
 LogArgument = Annotated[
@@ -81,7 +80,7 @@ LoggedOdometryOption = Annotated[
 ]
 
 
-def reversing_note(reversing: ReversingRepair | None) -> str | None:
+def _reversing_note(reversing: ReversingRepair | None) -> str | None:
     """What the odometry repair did, for stderr (None: nothing repaired)."""
     if reversing is None or not reversing.reversed_steps:
         return None
@@ -142,7 +141,7 @@ class LogSource(NamedTuple):
     def read(self, error: Callable[[str], RoverlabError]) -> tuple[LaserLog, str | None]:
         """Load a CARMEN log or a bag (with the bag options), keeping the ``first`` scans;
         unless ``logged_odometry``, a CARMEN log's steps that went forward while reversing
-        are repaired. Also returns :func:`reversing_note` of the repair.
+        are repaired. Also returns :func:`_reversing_note` of the repair.
 
         Raises:
             LogError: the log cannot be read.
@@ -163,4 +162,4 @@ class LogSource(NamedTuple):
                 odom_frame=self.odom_frame,
                 base_frame=self.base_frame,
             )
-        return (records[:first] if first is not None else records), reversing_note(reversing)
+        return (records[:first] if first is not None else records), _reversing_note(reversing)
