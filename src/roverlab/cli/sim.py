@@ -20,7 +20,6 @@ from roverlab.core import Context, configure_logging
 from roverlab.description.check import robot_warnings
 from roverlab.sim.app import Simulation, SimulationError
 from roverlab.sim.node import SpawnPose
-from roverlab.viz.server import DashboardServer
 from roverlab.world import world_warnings
 
 
@@ -188,6 +187,8 @@ def _run(
         err=True,
     )
     if dashboard:  # the context's shutdown (end of run_context) stops it
+        from roverlab.viz.server import DashboardServer  # FastAPI: only with --dashboard
+
         try:
             server = DashboardServer(context, "127.0.0.1", dashboard_port)
             server.start()

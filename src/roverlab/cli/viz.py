@@ -17,7 +17,7 @@ from roverlab.viz.errors import DashboardError
 from roverlab.viz.launcher import image_view_config
 from roverlab.viz.server import DashboardServer
 
-__all__ = ["dashboard", "image_view", "load_dashboard_config"]
+__all__ = ["dashboard", "image_app", "image_view", "load_dashboard_config"]
 
 # the options of both pages (dashboard, image_view) besides --host
 PortOption = Annotated[int, typer.Option("--port", help="TCP port to serve on.")]
@@ -125,3 +125,9 @@ def image_view(
 ) -> None:
     """rqt_image_view: the dashboard with its image panel on TOPIC."""
     _serve(ctx, host, port, token, image_view_config(topic), None, Path("."))
+
+
+image_app = typer.Typer(
+    help="Camera images (rqt_image_view) in the dashboard's image panel.", no_args_is_help=True
+)
+image_app.command("view")(image_view)

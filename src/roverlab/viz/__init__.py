@@ -18,10 +18,14 @@ Example::
     server.start()          # open http://127.0.0.1:8080/
 """
 
-from roverlab.viz.bridge import VizBridge
-from roverlab.viz.errors import DashboardError
-from roverlab.viz.protocol import INITIALPOSE_COVARIANCE
-from roverlab.viz.server import DashboardServer, is_loopback
+import importlib
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from roverlab.viz.bridge import VizBridge
+    from roverlab.viz.errors import DashboardError
+    from roverlab.viz.protocol import INITIALPOSE_COVARIANCE
+    from roverlab.viz.server import DashboardServer, is_loopback
 
 __all__ = [
     "INITIALPOSE_COVARIANCE",
@@ -30,3 +34,19 @@ __all__ = [
     "VizBridge",
     "is_loopback",
 ]
+
+# Imported on first use: ``roverlab.viz.errors`` or ``.launcher`` must not load FastAPI
+# and uvicorn (about a second) into every process that only might serve a dashboard.
+_HOMES = {
+    "INITIALPOSE_COVARIANCE": "roverlab.viz.protocol",
+    "DashboardError": "roverlab.viz.errors",
+    "DashboardServer": "roverlab.viz.server",
+    "VizBridge": "roverlab.viz.bridge",
+    "is_loopback": "roverlab.viz.server",
+}
+
+
+def __getattr__(name: str) -> Any:
+    if name in _HOMES:
+        return getattr(importlib.import_module(_HOMES[name]), name)
+    raise AttributeError(f"module 'roverlab.viz' has no attribute {name!r}")

@@ -25,7 +25,6 @@ from roverlab.viz.config import (
     load_config,
 )
 from roverlab.viz.errors import DashboardError
-from roverlab.viz.server import DashboardServer
 
 __all__ = [
     "DEFAULT_PORT",
@@ -111,6 +110,8 @@ def start_rviz(
         config = default_config(parsed.fixed_frame or "map")
     elif parsed.fixed_frame:
         config.fixed_frame = parsed.fixed_frame
+    from roverlab.viz.server import DashboardServer  # FastAPI: only when a node asks for it
+
     host, port = _dashboard_address()
     server = DashboardServer(context, host, port, config=config, node_name=node_name)
     try:
@@ -174,6 +175,8 @@ def start_image_view(
     where = f"{source}: " if source else ""
     positional = [a for a in shlex.split(args) if not a.startswith("-")]
     topic = positional[0] if positional else remaps.get("image") or remaps.get("/image")
+    from roverlab.viz.server import DashboardServer  # FastAPI: only when a node asks for it
+
     host, port = _dashboard_address()
     for attempt in (port, 0):
         server = DashboardServer(
