@@ -13,18 +13,14 @@ the file and the node.
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from typing import Final
 
 from roverlab.core import Node
 from roverlab.drivers.arbotix.node import ArbotixDriver
-from roverlab.drivers.rplidar.node import RplidarNode
 from roverlab.drivers.serial_base.node import ArduinoBaseNode
-from roverlab.drivers.usb_cam.node import UsbCamNode
 from roverlab.errors import RoverlabError
-from roverlab.launch.state import LaunchState, NodeFactory, node_kwargs
+from roverlab.launch.state import LaunchState, NodeFactory, node_factory, node_kwargs
 from roverlab.launch.xml import LaunchError, NodeSpec
-from roverlab.perception.face_detector.node import FaceDetectorNode
 
 __all__ = ["DEVICE_NODES"]
 
@@ -40,19 +36,6 @@ def _arbotix(state: LaunchState, spec: NodeSpec) -> Node | None:
         return ArbotixDriver(state.context, node_name=spec.name, **node_kwargs(spec))
     except (RoverlabError, ValueError) as err:
         raise LaunchError(f"{spec.source}: {spec.pkg}/{spec.type}: {err}") from err
-
-
-def _plain(make: Callable[..., Node]) -> NodeFactory:
-    """A node built from its ``<node>`` (private params, remaps); a bad configuration is a
-    LaunchError naming the file."""
-
-    def factory(state: LaunchState, spec: NodeSpec) -> Node:
-        try:
-            return make(state.context, node_name=spec.name, **node_kwargs(spec))
-        except (RoverlabError, ValueError) as err:
-            raise LaunchError(f"{spec.source}: {spec.pkg}/{spec.type}: {err}") from err
-
-    return factory
 
 
 ROBORTS_BASE_KEYS: Final = (
@@ -96,12 +79,16 @@ def _roborts_base(state: LaunchState, spec: NodeSpec) -> Node:
         raise LaunchError(f"{spec.source}: {spec.pkg}/{spec.type}: {err}") from err
 
 
+_SERIAL_BASE = "roverlab.drivers.serial_base.node:ArduinoBaseNode"
+
 DEVICE_NODES: Final[dict[tuple[str, str], NodeFactory]] = {
     ("arbotix_python", "arbotix_driver"): _arbotix,
-    ("usb_cam", "usb_cam_node"): _plain(UsbCamNode),
-    ("rplidar_ros", "rplidarNode"): _plain(RplidarNode),
-    ("rplidar_ros", "rplidar_node"): _plain(RplidarNode),
-    ("ros_arduino_python", "arduino_node.py"): _plain(ArduinoBaseNode),
+    ("usb_cam", "usb_cam_node"): node_factory("roverlab.drivers.usb_cam.node:UsbCamNode"),
+    ("rplidar_ros", "rplidarNode"): node_factory("roverlab.drivers.rplidar.node:RplidarNode"),
+    ("rplidar_ros", "rplidar_node"): node_factory("roverlab.drivers.rplidar.node:RplidarNode"),
+    ("ros_arduino_python", "arduino_node.py"): node_factory(_SERIAL_BASE),
     ("roborts_base", "roborts_base_node"): _roborts_base,
-    ("face_detector", "face_detector"): _plain(FaceDetectorNode),
+    ("face_detector", "face_detector"): node_factory(
+        "roverlab.perception.face_detector.node:FaceDetectorNode"
+    ),
 }

@@ -16,21 +16,12 @@ from typing import Any
 from roverlab.core import Context, Node, QoSProfile
 from roverlab.description import load_robot
 from roverlab.description.node import JointStatePublisher, RobotStatePublisher
-from roverlab.errors import RoverlabError
 from roverlab.geometry import quat_from_rpy
 from roverlab.launch.devices import DEVICE_NODES
-from roverlab.launch.state import LaunchState, NodeFactory
+from roverlab.launch.state import LaunchState, NodeFactory, node_factory
 from roverlab.launch.xml import LaunchError, NodeSpec
-from roverlab.localization.amcl.node import AmclNode
-from roverlab.localization.fake_localization import FakeLocalization
 from roverlab.maps.node import MapSaver, MapServer
 from roverlab.msgs import classes as mc
-from roverlab.navigation.costmap.node import Costmap2DNode
-from roverlab.navigation.explore.node import Explore
-from roverlab.navigation.move_base.node import MoveBase
-from roverlab.slam.gmapping.node import SlamGMapping
-from roverlab.slam.graph.node import SlamKarto, SlamToolbox, SyncSlamToolbox
-from roverlab.slam.hector.node import HectorMapping
 from roverlab.viz.errors import DashboardError
 from roverlab.viz.joints import SLIDER_TOPIC
 from roverlab.viz.launcher import start_image_view, start_rviz
@@ -292,29 +283,23 @@ def _map_saver(state: LaunchState, spec: NodeSpec) -> Node:
     return MapSaver(state.context, path_prefix=prefix, node_name=spec.name, **_kwargs(spec))
 
 
-def _slam_node(make: Callable[..., Node]) -> NodeFactory:
-    """A SLAM node from its ``<node>``: private ``<param>``s/``<rosparam>`` and remaps pass
-    through; a bad value is a LaunchError naming the file (unused ones are warned about)."""
-
-    def factory(state: LaunchState, spec: NodeSpec) -> Node:
-        try:
-            return make(state.context, node_name=spec.name, **_kwargs(spec))
-        except (RoverlabError, ValueError) as err:
-            raise LaunchError(f"{spec.source}: {spec.pkg}/{spec.type}: {err}") from err
-
-    return factory
-
-
-REGISTRY[("gmapping", "slam_gmapping")] = _slam_node(SlamGMapping)
-REGISTRY[("hector_mapping", "hector_mapping")] = _slam_node(HectorMapping)
-REGISTRY[("slam_toolbox", "async_slam_toolbox_node")] = _slam_node(SlamToolbox)
-REGISTRY[("slam_toolbox", "sync_slam_toolbox_node")] = _slam_node(SyncSlamToolbox)
-REGISTRY[("slam_karto", "slam_karto")] = _slam_node(SlamKarto)
-REGISTRY[("costmap_2d", "costmap_2d_node")] = _slam_node(Costmap2DNode)
-REGISTRY[("amcl", "amcl")] = _slam_node(AmclNode)
-REGISTRY[("fake_localization", "fake_localization")] = _slam_node(FakeLocalization)
-REGISTRY[("move_base", "move_base")] = _slam_node(MoveBase)
-REGISTRY[("explore_lite", "explore")] = _slam_node(Explore)
+# The algorithm nodes, imported when a launch first starts one.
+_NODES = {
+    ("gmapping", "slam_gmapping"): "roverlab.slam.gmapping.node:SlamGMapping",
+    ("hector_mapping", "hector_mapping"): "roverlab.slam.hector.node:HectorMapping",
+    ("slam_toolbox", "async_slam_toolbox_node"): "roverlab.slam.graph.node:SlamToolbox",
+    ("slam_toolbox", "sync_slam_toolbox_node"): "roverlab.slam.graph.node:SyncSlamToolbox",
+    ("slam_karto", "slam_karto"): "roverlab.slam.graph.node:SlamKarto",
+    ("costmap_2d", "costmap_2d_node"): "roverlab.navigation.costmap.node:Costmap2DNode",
+    ("amcl", "amcl"): "roverlab.localization.amcl.node:AmclNode",
+    ("fake_localization", "fake_localization"): (
+        "roverlab.localization.fake_localization:FakeLocalization"
+    ),
+    ("move_base", "move_base"): "roverlab.navigation.move_base.node:MoveBase",
+    ("explore_lite", "explore"): "roverlab.navigation.explore.node:Explore",
+}
+for _key, _path in _NODES.items():
+    REGISTRY[_key] = node_factory(_path)
 
 
 def _unavailable(reason: str) -> NodeFactory:

@@ -2,14 +2,16 @@
 
 from __future__ import annotations
 
+import importlib
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
 from roverlab.core import Context, Node
-from roverlab.launch.xml import NodeSpec
+from roverlab.errors import RoverlabError
+from roverlab.launch.xml import LaunchError, NodeSpec
 
-__all__ = ["LaunchState", "NodeFactory", "node_kwargs"]
+__all__ = ["LaunchState", "NodeFactory", "node_factory", "node_kwargs"]
 
 
 @dataclass
@@ -37,3 +39,21 @@ def node_kwargs(spec: NodeSpec) -> dict[str, Any]:
         "parameter_overrides": spec.params,
         "remappings": spec.remaps,
     }
+
+
+def node_factory(path: str) -> NodeFactory:
+    """The factory of a plain node: the class at ``"module:Class"`` built from its
+    ``<node>`` (private parameters, remaps); a bad configuration is a LaunchError naming
+    the file. The module is imported when a launch first starts such a node, so a launch
+    pays only for the nodes it runs."""
+    module, _, name = path.partition(":")
+
+    def factory(state: LaunchState, spec: NodeSpec) -> Node:
+        make = getattr(importlib.import_module(module), name)
+        try:
+            node: Node = make(state.context, node_name=spec.name, **node_kwargs(spec))
+        except (RoverlabError, ValueError) as err:
+            raise LaunchError(f"{spec.source}: {spec.pkg}/{spec.type}: {err}") from err
+        return node
+
+    return factory
