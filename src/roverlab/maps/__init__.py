@@ -2,6 +2,7 @@
 
 * :mod:`.grid`: :class:`LogOddsGrid` and :class:`CountGrid`, occupancy grids that integrate
   laser scans with a compiled ray tracer and grow as a SLAM map needs;
+* :mod:`.raytrace`: that ray tracer and the compiled kernels that apply a scan to a grid;
 * :mod:`.map_io`: map_server's YAML + PGM/PNG maps, read with map_server's exact pixel
   rules (trinary, scale, raw, negate, alpha) and written byte for byte as map_saver does;
 * :mod:`.node`: the ``map_server`` and ``map_saver`` nodes (import them from

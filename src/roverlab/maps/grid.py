@@ -27,21 +27,27 @@ Beams (gmapping's ``maxRange`` / ``maxUrange`` semantics), for a laser at ``pose
   ``clear_max_range=False`` readings at or beyond ``range_max`` are skipped instead,
   as gmapping does.
 
-The hot loops (tracing, updating) are numba-compiled; there is no Python loop over beams or
-cells. Grids grow (:meth:`ensure_contains`, ``update_scan(..., grow=True)``) by whole cells,
-keeping their content and cell alignment, so a SLAM map can start small.
+The hot loops (tracing, updating) are numba-compiled (:mod:`roverlab.maps.raytrace`); there
+is no Python loop over beams or cells. Grids grow (:meth:`ensure_contains`,
+``update_scan(..., grow=True)``) by whole cells, keeping their content and cell alignment,
+so a SLAM map can start small.
 """
 
 from __future__ import annotations
 
 import math
-from typing import Any, ClassVar
+from typing import Any, ClassVar, Generic, NamedTuple, TypeVar
 
-import numba
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from roverlab.maps.errors import GridError
+from roverlab.maps.raytrace import (
+    integrate_counts,
+    integrate_log_odds,
+    trace_cells,
+    trace_segment_cells,
+)
 from roverlab.msgs import array_to_occupancy_grid
 from roverlab.msgs import classes as mc
 
@@ -54,180 +60,7 @@ __all__ = [
     "trace_segment_cells",
 ]
 
-_jit = numba.njit(cache=True, nogil=True)
-
-
-# --------------------------------------------------------------------------------- kernels
-@_jit
-def _clip(p: float, q: float, t0: float, t1: float) -> tuple[float, float]:
-    """One Liang-Barsky edge ``p * t <= q`` applied to the interval ``[t0, t1]``."""
-    if p == 0.0:
-        if q < 0.0:
-            return 1.0, 0.0
-        return t0, t1
-    r = q / p
-    if p < 0.0:
-        if r > t0:
-            t0 = r
-    elif r < t1:
-        t1 = r
-    return t0, t1
-
-
-@_jit
-def _trace(
-    gx0: float, gy0: float, gx1: float, gy1: float, w: int, h: int, out: NDArray[np.int64]
-) -> int:
-    """Write the flat indices ``iy * w + ix`` of the cells of ``[0, w) x [0, h)`` (cell
-    units) that the segment ``g0 -> g1`` crosses, in order from ``g0``; return their count."""
-    dx = gx1 - gx0
-    dy = gy1 - gy0
-    t0, t1 = _clip(-dx, gx0, 0.0, 1.0)
-    t0, t1 = _clip(dx, w - gx0, t0, t1)
-    t0, t1 = _clip(-dy, gy0, t0, t1)
-    t0, t1 = _clip(dy, h - gy0, t0, t1)
-    if t0 > t1:
-        return 0
-    ix = min(max(int(math.floor(gx0 + t0 * dx)), 0), w - 1)
-    iy = min(max(int(math.floor(gy0 + t0 * dy)), 0), h - 1)
-    stepx = 1 if dx > 0.0 else (-1 if dx < 0.0 else 0)
-    stepy = 1 if dy > 0.0 else (-1 if dy < 0.0 else 0)
-    offx = 1 if dx > 0.0 else 0
-    offy = 1 if dy > 0.0 else 0
-    cap = out.shape[0]
-    n = 0
-    while n < cap:
-        out[n] = iy * w + ix
-        n += 1
-        tx = (ix + offx - gx0) / dx if stepx != 0 else math.inf
-        ty = (iy + offy - gy0) / dy if stepy != 0 else math.inf
-        if tx <= ty:
-            if tx >= t1:
-                break
-            ix += stepx
-            if ix < 0 or ix >= w:
-                break
-        else:
-            if ty >= t1:
-                break
-            iy += stepy
-            if iy < 0 or iy >= h:
-                break
-    return n
-
-
-#: The compiled tracer itself, for other compiled kernels (the costmap's obstacle-layer
-#: clearing): ``trace_segment_cells(gx0, gy0, gx1, gy1, w, h, out) -> n`` writes the flat
-#: indices ``iy * w + ix`` of the cells the segment crosses (cell units, clipped to the grid).
-trace_segment_cells = _trace
-
-
-@_jit
-def _integrate_log_odds(
-    lo: NDArray[np.float32],
-    mark: NDArray[np.uint8],
-    gx0: float,
-    gy0: float,
-    gxe: NDArray[np.float64],
-    gye: NDArray[np.float64],
-    hit: NDArray[np.bool_],
-    w: int,
-    h: int,
-    l_occ: float,
-    l_free: float,
-    l_min: float,
-    l_max: float,
-    touched: NDArray[np.int64],
-    buf: NDArray[np.int64],
-) -> int:
-    """Update each touched cell once (hits first); return how many cells changed."""
-    nt = 0
-    cap = touched.shape[0]
-    nb = gxe.shape[0]
-    for b in range(nb):
-        if not hit[b]:
-            continue
-        ix = int(math.floor(gxe[b]))
-        iy = int(math.floor(gye[b]))
-        if ix < 0 or ix >= w or iy < 0 or iy >= h:
-            continue
-        c = iy * w + ix
-        if mark[c] == 0 and nt < cap:
-            mark[c] = 1
-            touched[nt] = c
-            nt += 1
-            lo[c] = min(max(lo[c] + l_occ, l_min), l_max)
-    for b in range(nb):
-        k = _trace(gx0, gy0, gxe[b], gye[b], w, h, buf)
-        for j in range(k):
-            c = buf[j]
-            if mark[c] == 0 and nt < cap:
-                mark[c] = 1
-                touched[nt] = c
-                nt += 1
-                lo[c] = min(max(lo[c] + l_free, l_min), l_max)
-    for j in range(nt):
-        mark[touched[j]] = 0
-    return nt
-
-
-@_jit
-def _integrate_counts(
-    hits: NDArray[np.int32],
-    visits: NDArray[np.int32],
-    gx0: float,
-    gy0: float,
-    gxe: NDArray[np.float64],
-    gye: NDArray[np.float64],
-    hit: NDArray[np.bool_],
-    w: int,
-    h: int,
-    buf: NDArray[np.int64],
-) -> None:
-    """Per beam: visit every crossed cell once, and hit (and visit) the end cell."""
-    for b in range(gxe.shape[0]):
-        end = -1
-        if hit[b]:
-            ix = int(math.floor(gxe[b]))
-            iy = int(math.floor(gye[b]))
-            if 0 <= ix < w and 0 <= iy < h:
-                end = iy * w + ix
-                hits[end] += 1
-                visits[end] += 1
-        k = _trace(gx0, gy0, gxe[b], gye[b], w, h, buf)
-        for j in range(k):
-            c = buf[j]
-            if c != end:
-                visits[c] += 1
-
-
-def trace_cells(
-    start_xy: tuple[float, float],
-    end_xy: tuple[float, float],
-    *,
-    resolution: float,
-    origin_xy: tuple[float, float],
-    width: int,
-    height: int,
-) -> NDArray[np.int64]:
-    """The cells a segment crosses, in order, as an ``(N, 2)`` array of ``(ix, iy)``.
-
-    The tracer the grids use, for tests and tools; cells outside the grid are left out.
-    """
-    res = float(resolution)
-    ox, oy = float(origin_xy[0]), float(origin_xy[1])
-    buf = np.empty(int(width) + int(height) + 2, dtype=np.int64)
-    n = _trace(
-        (float(start_xy[0]) - ox) / res,
-        (float(start_xy[1]) - oy) / res,
-        (float(end_xy[0]) - ox) / res,
-        (float(end_xy[1]) - oy) / res,
-        int(width),
-        int(height),
-        buf,
-    )
-    flat = buf[:n]
-    return np.stack([flat % int(width), flat // int(width)], axis=1)
+_R = TypeVar("_R")  # what a grid's update_scan returns
 
 
 # ------------------------------------------------------------------------------- geometry
@@ -303,7 +136,17 @@ class ScanRays:
         return float(xs.min()), float(ys.min()), float(xs.max()), float(ys.max())
 
 
-class _Grid:
+class _CellBeams(NamedTuple):
+    """A scan's beams in a grid's cell units, in the order the kernels take them."""
+
+    gx0: float  #: the laser
+    gy0: float
+    gxe: NDArray[np.float64]  #: the end points
+    gye: NDArray[np.float64]
+    hit: NDArray[np.bool_]  #: True where the end point is an obstacle
+
+
+class _Grid(Generic[_R]):
     """Geometry, conversions and growth shared by the grids."""
 
     _layer_fill: ClassVar[dict[str, Any]] = {}
@@ -439,18 +282,36 @@ class _Grid:
         """Re-allocate scratch space after growth."""
 
     # ----------------------------------------------------------------- scans
-    def _prepare(
+    def update_scan(
         self,
         pose: ArrayLike,
         ranges: ArrayLike,
         angles: ArrayLike,
         range_max: float,
-        range_min: float,
-        usable_range: float | None,
-        clear_max_range: bool,
-        grow: bool,
-    ) -> tuple[float, float, NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_]]:
-        """The scan's beams in cell units: laser ``gx0, gy0``, ends ``gxe, gye``, hit flags."""
+        *,
+        range_min: float = 0.0,
+        usable_range: float | None = None,
+        clear_max_range: bool = True,
+        grow: bool = False,
+    ) -> _R:
+        """Integrate one scan.
+
+        Args:
+            pose: ``(x, y, theta)`` of the laser in the map frame, m and rad.
+            ranges: ``(N,)`` readings, m (``inf`` = nothing within range).
+            angles: ``(N,)`` beam angles in the laser frame, rad.
+            range_max: the sensor's maximum range, m.
+            range_min: readings below it are skipped, m.
+            usable_range: beams are used up to this range (gmapping's ``maxUrange``), m.
+            clear_max_range: free the cells along beams at or beyond ``range_max``.
+            grow: first grow the grid to hold the laser and every end point.
+
+        Returns:
+            :class:`LogOddsGrid`: how many cells changed; :class:`CountGrid`: None.
+
+        Raises:
+            GridError: mismatched or non-finite inputs.
+        """
         rays = ScanRays(
             pose,
             ranges,
@@ -462,14 +323,22 @@ class _Grid:
         )
         if grow:
             self._ensure_box(*rays.bounds(), None)
-        gx0 = (rays.origin[0] - self._ox) / self._res
-        gy0 = (rays.origin[1] - self._oy) / self._res
-        gxe = np.ascontiguousarray((rays.ends[:, 0] - self._ox) / self._res)
-        gye = np.ascontiguousarray((rays.ends[:, 1] - self._oy) / self._res)
         need = self._w + self._h + 2
         if self._buf.shape[0] < need:
             self._buf = np.empty(need, dtype=np.int64)
-        return gx0, gy0, gxe, gye, np.ascontiguousarray(rays.hit)
+        return self._integrate(
+            _CellBeams(
+                (rays.origin[0] - self._ox) / self._res,
+                (rays.origin[1] - self._oy) / self._res,
+                np.ascontiguousarray((rays.ends[:, 0] - self._ox) / self._res),
+                np.ascontiguousarray((rays.ends[:, 1] - self._oy) / self._res),
+                np.ascontiguousarray(rays.hit),
+            )
+        )
+
+    def _integrate(self, beams: _CellBeams) -> _R:  # pragma: no cover - overridden
+        """Apply the beams of one scan to the cells."""
+        raise NotImplementedError
 
     def to_occupancy(self) -> NDArray[np.int8]:  # pragma: no cover - overridden
         raise NotImplementedError
@@ -503,7 +372,7 @@ def _check_thresholds(occupied_thresh: float, free_thresh: float) -> None:
 
 
 # --------------------------------------------------------------------------------- grids
-class LogOddsGrid(_Grid):
+class LogOddsGrid(_Grid[int]):
     """An occupancy grid of clamped log-odds values (0 = unknown, p = 0.5).
 
     Args:
@@ -557,50 +426,15 @@ class LogOddsGrid(_Grid):
         """The ``(height, width)`` float32 cells (a live view: writes change the grid)."""
         return self._lo
 
-    def update_scan(
-        self,
-        pose: ArrayLike,
-        ranges: ArrayLike,
-        angles: ArrayLike,
-        range_max: float,
-        *,
-        range_min: float = 0.0,
-        usable_range: float | None = None,
-        clear_max_range: bool = True,
-        grow: bool = False,
-    ) -> int:
-        """Integrate one scan.
-
-        Args:
-            pose: ``(x, y, theta)`` of the laser in the map frame, m and rad.
-            ranges: ``(N,)`` readings, m (``inf`` = nothing within range).
-            angles: ``(N,)`` beam angles in the laser frame, rad.
-            range_max: the sensor's maximum range, m.
-            range_min: readings below it are skipped, m.
-            usable_range: beams are used up to this range (gmapping's ``maxUrange``), m.
-            clear_max_range: free the cells along beams at or beyond ``range_max``.
-            grow: first grow the grid to hold the laser and every end point.
-
-        Returns:
-            How many cells changed.
-
-        Raises:
-            GridError: mismatched or non-finite inputs.
-        """
-        gx0, gy0, gxe, gye, hit = self._prepare(
-            pose, ranges, angles, range_max, range_min, usable_range, clear_max_range, grow
-        )
+    def _integrate(self, beams: _CellBeams) -> int:
+        gx0, gy0, gxe, gye, _ = beams
         bound = int(np.sum(np.ceil(np.abs(gxe - gx0)) + np.ceil(np.abs(gye - gy0)) + 5.0))
         touched = np.empty(min(bound, self._w * self._h), dtype=np.int64)
         return int(
-            _integrate_log_odds(
+            integrate_log_odds(
                 self._lo.reshape(-1),
                 self._mark,
-                gx0,
-                gy0,
-                gxe,
-                gye,
-                hit,
+                *beams,
                 self._w,
                 self._h,
                 self.l_occ,
@@ -628,7 +462,7 @@ class LogOddsGrid(_Grid):
         return out
 
 
-class CountGrid(_Grid):
+class CountGrid(_Grid[None]):
     """An occupancy grid of hit and visit counts (gmapping's map).
 
     Args:
@@ -663,34 +497,11 @@ class CountGrid(_Grid):
         """``(height, width)`` count of beams that passed through or ended in each cell."""
         return self._visits
 
-    def update_scan(
-        self,
-        pose: ArrayLike,
-        ranges: ArrayLike,
-        angles: ArrayLike,
-        range_max: float,
-        *,
-        range_min: float = 0.0,
-        usable_range: float | None = None,
-        clear_max_range: bool = True,
-        grow: bool = False,
-    ) -> None:
-        """Integrate one scan (arguments as :meth:`LogOddsGrid.update_scan`).
-
-        Raises:
-            GridError: mismatched or non-finite inputs.
-        """
-        gx0, gy0, gxe, gye, hit = self._prepare(
-            pose, ranges, angles, range_max, range_min, usable_range, clear_max_range, grow
-        )
-        _integrate_counts(
+    def _integrate(self, beams: _CellBeams) -> None:
+        integrate_counts(
             self._hits.reshape(-1),
             self._visits.reshape(-1),
-            gx0,
-            gy0,
-            gxe,
-            gye,
-            hit,
+            *beams,
             self._w,
             self._h,
             self._buf,

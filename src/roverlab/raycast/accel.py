@@ -30,6 +30,7 @@ __all__ = [
     "Grid",
     "build_grid",
     "circle_hit",
+    "dda_steps",
     "grid_entry",
     "scene_grid",
     "segment_distance",
@@ -236,6 +237,23 @@ def grid_entry(
     ix = min(max(ix, 0), nx - 1)
     iy = min(max(iy, 0), ny - 1)
     return t0, ix, iy
+
+
+@_jit
+def dda_steps(dx: float, dy: float) -> tuple[int, int, int, int, float, float]:
+    """The constants of a grid walk (Amanatides-Woo) along direction ``(dx, dy)``.
+
+    Returns ``(stepx, stepy, offx, offy, invdx, invdy)``: the cell step along each axis
+    (-1, 0 or 1), 1 where the next boundary is the cell's upper side (else 0), and the
+    inverse components (0 for a zero component, whose boundaries are never reached).
+    """
+    stepx = 1 if dx > 0.0 else (-1 if dx < 0.0 else 0)
+    stepy = 1 if dy > 0.0 else (-1 if dy < 0.0 else 0)
+    offx = 1 if dx > 0.0 else 0
+    offy = 1 if dy > 0.0 else 0
+    invdx = 1.0 / dx if dx != 0.0 else 0.0
+    invdy = 1.0 / dy if dy != 0.0 else 0.0
+    return stepx, stepy, offx, offy, invdx, invdy
 
 
 @_jit

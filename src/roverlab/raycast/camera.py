@@ -377,6 +377,16 @@ def depth_to_points(
     return np.ascontiguousarray(pts[valid.reshape(-1)])
 
 
+def _points3(points: ArrayLike) -> NDArray[np.floating]:
+    """``points`` as a float array of shape (..., 3) (float64 unless already floating)."""
+    p = np.asarray(points)
+    if not np.issubdtype(p.dtype, np.floating):
+        p = p.astype(np.float64)
+    if p.shape[-1] != 3:
+        raise RaycastInputError(f"points must have shape (..., 3), got {p.shape}")
+    return p
+
+
 def optical_to_body(points: ArrayLike) -> NDArray[np.floating]:
     """Optical-frame points (x right, y down, z forward) -> body frame (x fwd, y left, z up).
 
@@ -386,11 +396,7 @@ def optical_to_body(points: ArrayLike) -> NDArray[np.floating]:
     Returns:
         Array of the same shape and float dtype: ``(z, -x, -y)``.
     """
-    p = np.asarray(points)
-    if not np.issubdtype(p.dtype, np.floating):
-        p = p.astype(np.float64)
-    if p.shape[-1] != 3:
-        raise RaycastInputError(f"points must have shape (..., 3), got {p.shape}")
+    p = _points3(points)
     return np.stack([p[..., 2], -p[..., 0], -p[..., 1]], axis=-1)
 
 
@@ -403,9 +409,5 @@ def body_to_optical(points: ArrayLike) -> NDArray[np.floating]:
     Returns:
         Array of the same shape and float dtype: ``(-y, -z, x)``.
     """
-    p = np.asarray(points)
-    if not np.issubdtype(p.dtype, np.floating):
-        p = p.astype(np.float64)
-    if p.shape[-1] != 3:
-        raise RaycastInputError(f"points must have shape (..., 3), got {p.shape}")
+    p = _points3(points)
     return np.stack([-p[..., 1], -p[..., 2], p[..., 0]], axis=-1)

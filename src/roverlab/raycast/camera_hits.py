@@ -12,7 +12,7 @@ import numba
 import numpy as np
 from numpy.typing import NDArray
 
-from roverlab.raycast.accel import circle_hit, grid_entry, segment_hit
+from roverlab.raycast.accel import circle_hit, dda_steps, grid_entry, segment_hit
 
 __all__ = ["FLOOR_DARK", "MAX_LAYERS", "collect_hits", "row_ceil", "row_floor", "to_u8"]
 
@@ -131,12 +131,7 @@ def collect_hits(
         n = 0
         block = math.inf
         if t0 <= hmax:
-            stepx = 1 if dx > 0.0 else (-1 if dx < 0.0 else 0)
-            stepy = 1 if dy > 0.0 else (-1 if dy < 0.0 else 0)
-            offx = 1 if dx > 0.0 else 0
-            offy = 1 if dy > 0.0 else 0
-            invdx = 1.0 / dx if dx != 0.0 else 0.0
-            invdy = 1.0 / dy if dy != 0.0 else 0.0
+            stepx, stepy, offx, offy, invdx, invdy = dda_steps(dx, dy)
             while True:
                 tmx = (gx0 + (ix + offx) * cell - x) * invdx if stepx != 0 else math.inf
                 tmy = (gy0 + (iy + offy) * cell - y) * invdy if stepy != 0 else math.inf

@@ -20,7 +20,14 @@ import numba
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from roverlab.raycast.accel import Grid, circle_hit, grid_entry, scene_grid, segment_distance
+from roverlab.raycast.accel import (
+    Grid,
+    circle_hit,
+    dda_steps,
+    grid_entry,
+    scene_grid,
+    segment_distance,
+)
 from roverlab.raycast.errors import RaycastInputError
 from roverlab.raycast.scene import Scene
 from roverlab.raycast.sweep import SWEEP_MAX_PRIMITIVES_PER_BEAM, fan_step, sweep_fan
@@ -57,12 +64,7 @@ def _cast_ray(
     t0, ix, iy = grid_entry(ox, oy, dx, dy, gx0, gy0, cell, nx, ny)
     if t0 > rmax:
         return math.inf
-    stepx = 1 if dx > 0.0 else (-1 if dx < 0.0 else 0)
-    stepy = 1 if dy > 0.0 else (-1 if dy < 0.0 else 0)
-    offx = 1 if dx > 0.0 else 0
-    offy = 1 if dy > 0.0 else 0
-    invdx = 1.0 / dx if dx != 0.0 else 0.0
-    invdy = 1.0 / dy if dy != 0.0 else 0.0
+    stepx, stepy, offx, offy, invdx, invdy = dda_steps(dx, dy)
     best = math.inf
     while True:
         tmx = (gx0 + (ix + offx) * cell - ox) * invdx if stepx != 0 else math.inf
@@ -167,12 +169,7 @@ def _grid_ray(
         return math.inf
     if grid[iy, ix] == occ:
         return t0
-    stepx = 1 if dx > 0.0 else (-1 if dx < 0.0 else 0)
-    stepy = 1 if dy > 0.0 else (-1 if dy < 0.0 else 0)
-    offx = 1 if dx > 0.0 else 0
-    offy = 1 if dy > 0.0 else 0
-    invdx = 1.0 / dx if dx != 0.0 else 0.0
-    invdy = 1.0 / dy if dy != 0.0 else 0.0
+    stepx, stepy, offx, offy, invdx, invdy = dda_steps(dx, dy)
     while True:
         tmx = ((ix + offx) - gx) * invdx if stepx != 0 else math.inf
         tmy = ((iy + offy) - gy) * invdy if stepy != 0 else math.inf

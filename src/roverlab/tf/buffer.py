@@ -1,9 +1,6 @@
 """tf2_ros's ``Buffer``: :class:`~roverlab.tf.buffer_core.BufferCore` plus a lock, lookups
-that wait up to a timeout for data to arrive, futures, and message conversion.
-
-Conventions (tf2's): ``lookup_transform(target, source, t)`` returns ``target_T_source``,
-the transform that maps a point expressed in ``source`` into ``target``; ``Time(0)`` asks for
-the latest time at which every edge of the chain has data.
+that wait up to a timeout for data to arrive, futures, and message conversion. Frames,
+times and lookups follow :mod:`roverlab.tf.buffer_core`'s conventions (tf2's).
 """
 
 from __future__ import annotations

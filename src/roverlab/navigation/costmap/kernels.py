@@ -13,7 +13,7 @@ import numba
 import numpy as np
 from numpy.typing import NDArray
 
-from roverlab.maps.grid import trace_segment_cells
+from roverlab.maps.raytrace import trace_segment_cells
 
 __all__ = [
     "bresenham",
@@ -149,7 +149,7 @@ def clear_rays(
 ) -> None:
     """Free every cell each ray ``(gx0, gy0) -> ends[k]`` (cell units) crosses, up to
     ``max_cells`` from the origin; the rays are traced by roverlab's shared grid tracer
-    (:func:`roverlab.maps.grid.trace_segment_cells`) and clipped to the grid."""
+    (:func:`roverlab.maps.raytrace.trace_segment_cells`) and clipped to the grid."""
     h, w = grid.shape
     flat = grid.reshape(-1)
     for k in range(ends.shape[0]):
