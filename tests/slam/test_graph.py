@@ -42,7 +42,7 @@ from roverlab.slam.graph import (
     run_graph,
     valid_points,
 )
-from roverlab.slam.graph.matcher import _lattice_responses
+from roverlab.slam.graph.kernels import _lattice_responses
 from roverlab.slam.graph.node import SlamKarto, SlamToolbox
 from roverlab.tf import Buffer, TransformListener
 from roverlab.world.yaml_world import world_from_dict

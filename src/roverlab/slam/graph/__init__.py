@@ -7,6 +7,7 @@
   ``run_log(log) -> GraphRun``.
 * :func:`run_graph`: ``run_graph(records, params_dict) -> GraphRun`` for the CLI.
 * :mod:`.matcher`: Karto's correlative scan matcher, searched by branch and bound.
+* :mod:`.kernels`: the matcher's compiled kernels.
 """
 
 from roverlab.slam.graph.errors import (
