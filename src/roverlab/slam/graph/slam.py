@@ -27,6 +27,10 @@ Per scan (:meth:`GraphSLAM.process`):
    against a wrong closure: if afterwards a loop or near-chain edge is off by more than
    ``loop_closure_max_residual``, the new closures are dropped and the poses restored.
 
+The edges, near chains and loop closing of steps 3 to 5 are in
+:class:`~roverlab.slam.graph.loops.LoopClosing` (a base class of :class:`GraphSLAM`); the
+keyframe record and the pose helpers on plain arrays in :mod:`roverlab.slam.graph.poses`.
+
 Unlike Karto, which drops the scans that are not keyframes, every scan gets a pose: it is
 matched against the running buffer like a keyframe and stored relative to its keyframe.
 The trajectory (:meth:`GraphSLAM.scan_poses`) places it relative to the optimised poses of
@@ -51,16 +55,15 @@ from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import breadth_first_order
 
 from roverlab.geometry import SE2
 from roverlab.maps.grid import CountGrid, scan_arrays
 from roverlab.slam.common import ScanLike
 from roverlab.slam.data.pose_solver import optimize
-from roverlab.slam.data.posegraph import PoseGraph, edge_errors
+from roverlab.slam.data.posegraph import PoseGraph
 from roverlab.slam.data.trajectory import Trajectory
 from roverlab.slam.graph.errors import GraphSlamInputError
+from roverlab.slam.graph.loops import _OPT_ITERATIONS, LoopClosing
 from roverlab.slam.graph.matcher import (
     CorrelationGrid,
     MatchResult,
@@ -72,6 +75,16 @@ from roverlab.slam.graph.matcher import (
     valid_points,
 )
 from roverlab.slam.graph.params import GraphParams
+from roverlab.slam.graph.poses import (
+    _compose,
+    _inverse,
+    _pose_array,
+    _relative,
+    _Scan,
+    _transform_points,
+    _weighted_mean,
+    _wrap,
+)
 from roverlab.slam.laser import beam_endpoints
 
 __all__ = ["GraphMap", "GraphRun", "GraphSLAM", "ScanLike", "run_graph", "run_log"]
@@ -81,9 +94,6 @@ FloatArray = NDArray[np.float64]
 #: Karto's ``OccupancyGrid`` defaults: minimum passes for a known cell, and hit ratio.
 MIN_PASS_THROUGH = 2
 OCCUPANCY_THRESHOLD = 0.1
-#: Largest number of solver iterations after a loop closure (warm-started).
-_OPT_ITERATIONS = 20
-_TWO_PI = 2.0 * math.pi
 #: Most re-centred searches when a sequential match lands on the rim of its angular window.
 _RIM_SEARCHES = 3
 
@@ -122,93 +132,10 @@ class GraphRun(NamedTuple):
     trajectory: Trajectory
 
 
-@dataclass(frozen=True, eq=False)
-class _Scan:
-    """What a keyframe keeps to be matched against and rendered."""
-
-    points: FloatArray  # (N, 2) robot frame, usable for matching
-    ranges: NDArray[np.float32]
-    angles: FloatArray
-    range_min: float
-    range_max: float
-    laser_offset: FloatArray  # (3,)
-
-
-# ------------------------------------------------------------------------------ pose helpers
-
-
-def _wrap(a: Any) -> Any:
-    return (np.asarray(a) + math.pi) % _TWO_PI - math.pi
-
-
-def _compose(a: FloatArray, b: FloatArray) -> FloatArray:
-    """``a * b`` row-wise for ``(..., 3)`` poses."""
-    a = np.asarray(a, dtype=np.float64)
-    b = np.asarray(b, dtype=np.float64)
-    c, s = np.cos(a[..., 2]), np.sin(a[..., 2])
-    return np.stack(
-        [
-            a[..., 0] + c * b[..., 0] - s * b[..., 1],
-            a[..., 1] + s * b[..., 0] + c * b[..., 1],
-            _wrap(a[..., 2] + b[..., 2]),
-        ],
-        axis=-1,
-    )
-
-
-def _relative(a: FloatArray, b: FloatArray) -> FloatArray:
-    """``a^-1 * b`` row-wise."""
-    a = np.asarray(a, dtype=np.float64)
-    b = np.asarray(b, dtype=np.float64)
-    c, s = np.cos(a[..., 2]), np.sin(a[..., 2])
-    dx, dy = b[..., 0] - a[..., 0], b[..., 1] - a[..., 1]
-    return np.stack([c * dx + s * dy, -s * dx + c * dy, _wrap(b[..., 2] - a[..., 2])], axis=-1)
-
-
-def _inverse(a: FloatArray) -> FloatArray:
-    return _relative(a, np.zeros_like(a))
-
-
-def _transform_points(pose: FloatArray, pts: FloatArray) -> FloatArray:
-    c, s = math.cos(pose[2]), math.sin(pose[2])
-    out = np.empty_like(pts)
-    out[:, 0] = pose[0] + c * pts[:, 0] - s * pts[:, 1]
-    out[:, 1] = pose[1] + s * pts[:, 0] + c * pts[:, 1]
-    return out
-
-
-def _pose_array(pose: ArrayLike | SE2, what: str) -> FloatArray:
-    arr = pose.as_array() if isinstance(pose, SE2) else np.asarray(pose, dtype=np.float64)
-    arr = np.asarray(arr, dtype=np.float64).reshape(-1)
-    if arr.shape != (3,) or not np.all(np.isfinite(arr)):
-        raise GraphSlamInputError(f"{what} must be 3 finite numbers (x, y, theta), got {arr}")
-    return arr
-
-
-def _runs(mask: NDArray[np.bool_]) -> list[tuple[int, int]]:
-    """``[start, stop)`` of every maximal run of True."""
-    m = np.concatenate([[False], mask, [False]]).astype(np.int8)
-    d = np.diff(m)
-    starts = np.flatnonzero(d == 1)
-    stops = np.flatnonzero(d == -1)
-    return list(zip(starts.tolist(), stops.tolist(), strict=True))
-
-
-def _information(cov: FloatArray, heading: float) -> FloatArray:
-    """Information of an edge whose target was matched with world covariance ``cov``:
-    rotated into the target's frame (the frame of the g2o error)."""
-    c, s = math.cos(heading), math.sin(heading)
-    r = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-    local = r.T @ cov @ r
-    local = 0.5 * (local + local.T) + np.eye(3) * 1e-12
-    info = np.linalg.inv(local)
-    return np.asarray(0.5 * (info + info.T), dtype=np.float64)
-
-
 # ------------------------------------------------------------------------------ the mapper
 
 
-class GraphSLAM:
+class GraphSLAM(LoopClosing):
     """Karto / slam_toolbox graph SLAM on plain arrays (no node, no clock, no TF).
 
     Args:
@@ -479,25 +406,6 @@ class GraphSLAM:
         return _compose(self._kf_pose[k], self._kf_scans[k].laser_offset)[:2]
 
     # ---------------------------------------------------------------- graph building
-    def _add_edge(self, i: int, j: int, mean_j: FloatArray, cov: FloatArray, kind: str) -> None:
-        if i == j:
-            return
-        for e in range(len(self._e_from)):  # edges of j are few and at the end
-            if self._e_to[-1 - e] != j:
-                break
-            if self._e_from[-1 - e] == i:
-                return  # Karto keeps the first edge between two scans
-        self._e_from.append(i)
-        self._e_to.append(j)
-        self._e_meas.append(_relative(self._kf_pose[i], mean_j))
-        self._e_info.append(_information(cov, float(mean_j[2])))
-        self._e_kind.append(kind)
-
-    def _closest(self, frames: list[int] | NDArray[np.intp], pose: FloatArray) -> int:
-        idx = np.asarray(frames, dtype=np.intp)
-        d = np.hypot(self._kf_pose[idx, 0] - pose[0], self._kf_pose[idx, 1] - pose[1])
-        return int(idx[int(np.argmin(d))])
-
     def _add_keyframe(
         self, pose: FloatArray, odom: FloatArray, scan: _Scan, cov: FloatArray | None
     ) -> None:
@@ -536,136 +444,6 @@ class GraphSLAM:
         if k > 0 and p.do_loop_closing and p.use_scan_matching and scan.points.shape[0] >= 3:
             self._try_close_loop(k)
         self._grid = self._seq_grid(self._buffer, self._kf_pose[k], self._laser_position(k))
-
-    def _near_linked(self, k: int, distance: float) -> NDArray[np.bool_]:
-        """Karto's ``FindNearLinkedScans``: keyframes reached from ``k`` through the graph,
-        visiting only keyframes within ``distance`` of ``k``."""
-        n = self.num_keyframes
-        d = self._kf_pose[:, :2] - self._kf_pose[k, :2]
-        within = np.einsum("ij,ij->i", d, d) < distance * distance + 1e-9
-        out = np.zeros(n, dtype=bool)
-        fr = np.asarray(self._e_from, dtype=np.intp)
-        to = np.asarray(self._e_to, dtype=np.intp)
-        ok = within[fr] & within[to]
-        sub = np.flatnonzero(within)
-        index = np.full(n, -1, dtype=np.intp)
-        index[sub] = np.arange(sub.size)
-        adj = coo_matrix(
-            (np.ones(int(ok.sum())), (index[fr[ok]], index[to[ok]])), shape=(sub.size, sub.size)
-        ).tocsr()
-        reached = breadth_first_order(adj, int(index[k]), directed=False, return_predecessors=False)
-        out[sub[np.asarray(reached, dtype=np.intp)]] = True
-        return out
-
-    def _chain_grid_match(
-        self, k: int, chain: list[int], start: FloatArray, *, cov: bool
-    ) -> MatchResult:
-        grid = self._seq_grid(chain, start, self._laser_position(k))
-        return self._match_sequential(
-            grid, self._kf_scans[k].points, start, penalise=False, cov=cov
-        )
-
-    def _link_near_chains(self, k: int) -> list[tuple[FloatArray, FloatArray]]:
-        """Karto's ``LinkNearChains``; returns the accepted matches (mean, covariance)."""
-        p = self.params
-        near = self._near_linked(k, p.link_scan_maximum_distance)
-        d = self._kf_pose[:, :2] - self._kf_pose[k, :2]
-        within = np.einsum("ij,ij->i", d, d) < p.link_scan_maximum_distance**2 + 1e-9
-        within[k] = True
-        out: list[tuple[FloatArray, FloatArray]] = []
-        for a, b in _runs(within):
-            if b > k:  # the chain holds the new keyframe itself: invalid
-                continue
-            if b - a < p.loop_match_minimum_chain_size or not near[a:b].any():
-                continue
-            chain = list(range(a, b))
-            res = self._chain_grid_match(k, chain, self._kf_pose[k], cov=True)
-            if res.response > p.link_match_minimum_response_fine - 1e-9:
-                self._add_edge(self._closest(chain, res.pose), k, res.pose, res.covariance, "near")
-                out.append((res.pose, res.covariance))
-        return out
-
-    def _loop_chains(self, k: int) -> list[list[int]]:
-        """Karto's ``FindPossibleLoopClosure``, all chains at once."""
-        p = self.params
-        dist = p.loop_search_maximum_distance
-        near = self._near_linked(k, dist)[:k]
-        d = self._kf_pose[:k, :2] - self._kf_pose[k, :2]
-        within = np.einsum("ij,ij->i", d, d) < dist * dist + 1e-9
-        cand = within & ~near
-        chains = []
-        for a, b in _runs(cand):
-            # a linked scan right after the run resets Karto's chain
-            if b < k and near[b] and within[b]:
-                continue
-            if b - a >= p.loop_match_minimum_chain_size:
-                chains.append(list(range(a, b)))
-        return chains
-
-    def _try_close_loop(self, k: int) -> None:
-        """Karto's ``TryCloseLoop`` plus an optimisation and a consistency check."""
-        p = self.params
-        added = 0
-        backup = self._kf_pose.copy()
-        n_edges = len(self._e_from)
-        for chain in self._loop_chains(k):
-            viewpoint = self._laser_position(k)
-            coarse_grid = build_grid(
-                self._world_points(chain, viewpoint),
-                resolution=p.loop_search_space_resolution,
-                smear_deviation=p.loop_search_space_smear_deviation,
-                block=self._loop_block,
-            )
-            coarse = match_scan(
-                coarse_grid,
-                self._kf_scans[k].points,
-                self._kf_pose[k],
-                search_dimension=p.loop_search_space_dimension,
-                coarse_angle_offset=p.coarse_search_angle_offset,
-                coarse_angle_resolution=p.coarse_angle_resolution,
-                fine_angle_offset=p.fine_search_angle_offset,
-                penalty=None,
-                refine_angle=False,
-                subcell=False,
-                covariance=True,
-                response_expansion=False,
-            )
-            if not (
-                coarse.response > p.loop_match_minimum_response_coarse
-                and coarse.covariance[0, 0] < p.loop_match_maximum_variance_coarse
-                and coarse.covariance[1, 1] < p.loop_match_maximum_variance_coarse
-            ):
-                continue
-            fine = self._chain_grid_match(k, chain, coarse.pose, cov=True)
-            if fine.response < p.loop_match_minimum_response_fine:
-                continue
-            self._kf_pose[k] = fine.pose
-            self._add_edge(self._closest(chain, fine.pose), k, fine.pose, fine.covariance, "loop")
-            added += 1
-        if not added:
-            return
-        if self._optimise_checked(n_edges):
-            self.loop_closures += added
-        else:
-            self.rejected_loop_closures += added
-            del self._e_from[n_edges:], self._e_to[n_edges:], self._e_meas[n_edges:]
-            del self._e_info[n_edges:], self._e_kind[n_edges:]
-            self._kf_pose = backup
-
-    def _optimise_checked(self, first_new: int) -> bool:
-        """Optimise; False (poses untouched) if a closure edge ends up inconsistent."""
-        graph = self.graph()
-        poses, _ = optimize(graph, max_iterations=_OPT_ITERATIONS)
-        self.optimisations += 1
-        limit = self.params.loop_closure_max_residual
-        if limit > 0.0:
-            err = edge_errors(graph, poses)
-            kinds = np.asarray(self._e_kind)
-            check = kinds != "sequential"
-            if np.any(np.hypot(err[check, 0], err[check, 1]) > limit):
-                return False
-        self._kf_pose = np.asarray(poses, dtype=np.float64).copy()
-        return True
 
     def optimise(self) -> None:
         """Optimise the whole graph now (no consistency check)."""
@@ -783,23 +561,6 @@ class GraphSLAM:
         return GraphRun(
             poses=poses, map=self.occupancy(), trajectory=Trajectory.from_poses(stamps, poses)
         )
-
-
-def _weighted_mean(means: list[FloatArray], covs: list[FloatArray]) -> FloatArray:
-    """Karto's ``ComputeWeightedMean``: positions weighted by inverse covariance, heading
-    the circular mean."""
-    infos = [np.linalg.inv(c + np.eye(3) * 1e-12) for c in covs]
-    total = np.linalg.inv(np.sum(infos, axis=0))
-    ref = means[0]
-    acc = np.zeros(3)
-    for m, info in zip(means, infos, strict=True):
-        v = m - ref
-        v[2] = _wrap(v[2])
-        acc += total @ info @ v
-    heading = math.atan2(
-        sum(math.sin(float(m[2])) for m in means), sum(math.cos(float(m[2])) for m in means)
-    )
-    return np.array([ref[0] + acc[0], ref[1] + acc[1], heading])
 
 
 def run_log(
