@@ -36,6 +36,10 @@ cannot recover from such a jump: its hill climbing only finds the nearest optimu
 Poses are of the robot (odometry ``base_frame``) in the map frame; the laser's pose on the
 robot is ``laser_offset``. All randomness comes from the ``numpy.random.Generator`` given
 to the constructor, so a seeded run is reproducible.
+
+The hill climbing and the recovery are in :class:`~roverlab.slam.gmapping.matching.ScanMatching`
+(a base class of :class:`GMapping`); the per-scan poses of :meth:`GMapping.run_log` in
+:mod:`roverlab.slam.gmapping.scan_poses`.
 """
 
 from __future__ import annotations
@@ -54,6 +58,7 @@ from roverlab.slam.common import ScanLike
 from roverlab.slam.gmapping import kernels
 from roverlab.slam.gmapping.errors import GMappingInputError
 from roverlab.slam.gmapping.grid import GMappingMap, ParticleMaps
+from roverlab.slam.gmapping.matching import _RECOVER_BELOW, ScanMatching, _Beams
 from roverlab.slam.gmapping.motion import (
     compose,
     motion_sigmas,
@@ -62,6 +67,7 @@ from roverlab.slam.gmapping.motion import (
     wrap,
 )
 from roverlab.slam.gmapping.params import GMappingParams
+from roverlab.slam.gmapping.scan_poses import _scan_poses
 
 __all__ = ["GMapping", "GMappingRun", "Particle", "ScanLike", "UpdateInfo", "run_log"]
 
@@ -73,24 +79,6 @@ _NULL_LIKELIHOOD = -0.5
 # that reports no motion (a temporal update) still lets the scan matcher move it a little.
 _MIN_SIGMA_XY = 0.01
 _MIN_SIGMA_TH = 0.005
-# Odometry-failure recovery (see GMapping._recover): triggered when the best particle's
-# matcher score is below this fraction of the beams; searches +-(0.5 m + twice the odometry
-# travel since the last update, at most 3 m) and +-45 degrees with about this many beams,
-# a kernel of this many cells, 2 degree steps; keeps a result that beats the local match by
-# this fraction of the beams.
-_RECOVER_BELOW = 0.7
-_RECOVER_LINEAR_M = 0.5
-_RECOVER_LINEAR_MAX_M = 3.0
-_RECOVER_ANGULAR_RAD = math.pi / 4.0
-_RECOVER_ANGULAR_STEP = math.radians(2.0)
-_RECOVER_BEAMS = 90
-_RECOVER_KERNEL = 2
-_RECOVER_CANDIDATES = 8
-_RECOVER_MARGIN = 0.15
-# Recovered poses within this fraction of the beams of the best one count as equally good;
-# the one nearest the odometry wins (a radian of heading counts as this many metres).
-_RECOVER_TIE = 0.03
-_RECOVER_RAD_TO_M = 1.0
 
 
 @dataclass(frozen=True, slots=True)
@@ -143,15 +131,7 @@ class GMappingRun(NamedTuple):
     timestamps: NDArray[np.float64]
 
 
-class _Beams(NamedTuple):
-    hit: NDArray[np.float64]  # (B, 2) matcher endpoints, robot frame
-    free: NDArray[np.float64]  # (B, 2) one cell back along each matcher beam
-    origin: NDArray[np.float64]  # (2,) laser position, robot frame
-    ends: NDArray[np.float64]  # (M, 2) map-update end points (cropped), robot frame
-    is_hit: NDArray[np.bool_]  # (M,) whether each map-update beam hit an obstacle
-
-
-class GMapping:
+class GMapping(ScanMatching):
     """slam_gmapping's particle filter on plain arrays (no node, no clock, no TF).
 
     Args:
@@ -502,100 +482,6 @@ class GMapping:
         self._finish_update(odom, t)
         self.history.append(UpdateInfo(t, neff, bool(resample)))
 
-    def _match(
-        self, starts: NDArray[np.float64], owners: NDArray[np.int64], beams: _Beams
-    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        p = self.params
-        ox, oy = self.maps.origin_xy
-        return kernels.match_all(
-            self.maps.cells,
-            np.ascontiguousarray(owners, dtype=np.int64),
-            ox,
-            oy,
-            p.delta,
-            np.ascontiguousarray(starts),
-            beams.hit,
-            beams.free,
-            p.kernelSize,
-            1.0 / p.sigma,
-            p.lstep,
-            p.astep,
-            p.iterations,
-        )
-
-    def _recover(
-        self,
-        beams: _Beams,
-        best: int,
-        matched: NDArray[np.float64],
-        scores: NDArray[np.float64],
-    ) -> None:
-        """Odometry-failure recovery: a wide search on the best particle's map.
-
-        Run when even the best particle matched less than half of the beams (a push, wheel
-        slip, odometry that counts reversing as driving forward): a window around its
-        odometry sample, as wide as twice the odometry travel since the last update plus
-        half a metre, and +-45 degrees, is scored on a coarse lattice (every few beams, a
-        wider kernel),
-        the best lattice poses are hill-climbed, and if one scores clearly better the same
-        correction is applied to every particle's odometry sample and climbed again;
-        each particle keeps whichever of its two matches scores higher.
-        """
-        p = self.params
-        n_beams = beams.hit.shape[0]
-        step = max(1, n_beams // _RECOVER_BEAMS)
-        pred = self._poses[best]
-        ox, oy = self.maps.origin_xy
-        lin_step = 2.0 * p.delta * _RECOVER_KERNEL
-        travelled = self._linear  # the odometry path since the last update
-        lin_half = min(_RECOVER_LINEAR_MAX_M, _RECOVER_LINEAR_M + 2.0 * travelled)
-        grid = kernels.search_window(
-            self.maps.cells,
-            best,
-            ox,
-            oy,
-            p.delta,
-            float(pred[0]),
-            float(pred[1]),
-            float(pred[2]),
-            np.ascontiguousarray(beams.hit[::step]),
-            np.ascontiguousarray(beams.free[::step]),
-            _RECOVER_KERNEL,
-            1.0 / p.sigma,
-            lin_half,
-            lin_step,
-            _RECOVER_ANGULAR_RAD,
-            _RECOVER_ANGULAR_STEP,
-        )
-        na = (grid.shape[0] - 1) // 2
-        nl = (grid.shape[1] - 1) // 2
-        a, i, j = _peaks(grid, _RECOVER_CANDIDATES)
-        starts = np.stack(
-            [
-                pred[0] + (i - nl) * lin_step,
-                pred[1] + (j - nl) * lin_step,
-                pred[2] + (a - na) * _RECOVER_ANGULAR_STEP,
-            ],
-            axis=1,
-        )
-        cand, cand_scores = self._match(starts, np.full(len(starts), best), beams)
-        need = max(scores[best] + _RECOVER_MARGIN * n_beams, _RECOVER_BELOW * n_beams)
-        if cand_scores.max() <= need:
-            return
-        # Among the (near) best, the smallest correction: in a corridor the position along
-        # it is ambiguous, and the odometry is the better guess there.
-        near_best = cand_scores >= cand_scores.max() - _RECOVER_TIE * n_beams
-        shift = relative(np.broadcast_to(pred, cand.shape), cand)
-        cost = np.hypot(shift[:, 0], shift[:, 1]) + np.abs(shift[:, 2]) * _RECOVER_RAD_TO_M
-        k = int(np.argmin(np.where(near_best, cost, np.inf)))
-        correction = shift[k]
-        starts = compose(self._poses, correction[None, :])
-        again, again_scores = self._match(starts, np.arange(p.particles), beams)
-        better = again_scores > scores
-        matched[better] = again[better]
-        scores[better] = again_scores[better]
-        self.recoveries += 1
-
     def _resample(self) -> None:
         n = self.params.particles
         w = self.weights()
@@ -678,76 +564,6 @@ def run_log(
 ) -> GMappingRun:
     """Run slam_gmapping over a whole laser log; see :meth:`GMapping.run_log`."""
     return GMapping(params, rng).run_log(log, interpolate=interpolate)
-
-
-def _scan_poses(
-    traj: NDArray[np.float64],
-    odo: NDArray[np.float64],
-    after: NDArray[np.int64],
-    update_scans: NDArray[np.int64],
-    smooth: GMappingParams | None,
-) -> NDArray[np.float64]:
-    """One robot pose per scan from the poses at the updates and the odometry.
-
-    Args:
-        traj: (K, 3) poses at the K updates.
-        odo: (N, 3) odometry pose of each scan.
-        after: (N,) the last update at or before each scan (-1: none yet).
-        update_scans: (K,) the scan of each update.
-        smooth: the parameters, to blend with the next update (see ``run_log``); ``None``
-            for plain forward propagation.
-    """
-    poses = odo.copy()  # ahead of the first update the map frame is the odometry frame
-    seen = after >= 0
-    if not np.any(seen) or traj.shape[0] == 0:
-        return poses
-    k = after[seen]
-    fwd = compose(traj[k], relative(odo[update_scans[k]], odo[seen]))
-    poses[seen] = fwd
-    if smooth is None or traj.shape[0] < 2:
-        return poses
-    # Progress along the odometry in units of the update thresholds.
-    step = relative(odo[:-1], odo[1:])
-    lin = np.hypot(step[:, 0], step[:, 1])
-    ang = np.abs(step[:, 2])
-    prog = np.zeros(len(step))
-    if smooth.linearUpdate > 0.0:
-        prog += lin / smooth.linearUpdate
-    if smooth.angularUpdate > 0.0:
-        prog += ang / smooth.angularUpdate
-    if smooth.linearUpdate <= 0.0 and smooth.angularUpdate <= 0.0:
-        prog += 1.0
-    cum = np.concatenate([[0.0], np.cumsum(prog)])
-    nxt = np.minimum(k + 1, traj.shape[0] - 1)
-    has_next = nxt > k
-    if not np.any(has_next):
-        return poses
-    idx = np.flatnonzero(seen)[has_next]
-    k, nxt, fwd = k[has_next], nxt[has_next], fwd[has_next]
-    bwd = compose(traj[nxt], relative(odo[update_scans[nxt]], odo[idx]))
-    span = cum[update_scans[nxt]] - cum[update_scans[k]]
-    done = cum[idx] - cum[update_scans[k]]
-    alpha = np.where(span > 0.0, done / np.where(span > 0.0, span, 1.0), 0.0)
-    alpha = np.clip(alpha, 0.0, 1.0)
-    blend = np.empty_like(fwd)
-    blend[:, :2] = (1.0 - alpha[:, None]) * fwd[:, :2] + alpha[:, None] * bwd[:, :2]
-    blend[:, 2] = wrap(fwd[:, 2] + alpha * wrap(bwd[:, 2] - fwd[:, 2]))
-    poses[idx] = blend
-    return poses
-
-
-def _peaks(grid: NDArray[np.float64], k: int) -> tuple[NDArray[np.intp], ...]:
-    """Indices of up to ``k`` best cells of ``grid``, no two within one cell of each other."""
-    order = np.argsort(grid, axis=None)[::-1]
-    chosen: list[NDArray[np.intp]] = []
-    for flat in order[: 64 * k]:
-        idx = np.array(np.unravel_index(flat, grid.shape))
-        if all(np.abs(idx - c).max() > 1 for c in chosen):
-            chosen.append(idx)
-            if len(chosen) == k:
-                break
-    arr = np.array(chosen).reshape(-1, grid.ndim)
-    return tuple(arr[:, d] for d in range(grid.ndim))
 
 
 def _draw_gaussian(
