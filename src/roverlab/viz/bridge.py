@@ -8,6 +8,9 @@ threads read snapshots and compare versions, so each client gets only what chang
 message becomes is each display type's own handler (:mod:`roverlab.viz.handlers`, one per
 display, as rviz has one plugin per display). Configuration changes from the page are
 applied on the executor thread (:meth:`VizBridge.set_config`).
+
+The status tree the page shows (:meth:`VizBridge.status`) is built by
+:class:`~roverlab.viz.status.DisplayStatus`, a base class of :class:`VizBridge`.
 """
 
 from __future__ import annotations
@@ -19,7 +22,6 @@ import threading
 import time
 from collections import deque
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Final
 
@@ -68,6 +70,7 @@ from roverlab.viz.protocol import (
     robot_outlines,
     robot_shapes,
 )
+from roverlab.viz.status import DisplayStatus, TopicInfo
 
 __all__ = [
     "COMPRESSED_TYPE",
@@ -104,16 +107,6 @@ class RvizNode(Node):
         super().destroy_node()
 
 
-@dataclass(frozen=True)
-class TopicInfo:
-    """One topic of the running system, as the topic list shows it."""
-
-    name: str
-    typename: str
-    publishers: int
-    subscribers: int
-
-
 def _xyyaw(t: Transform3) -> list[float]:
     return [
         round(t.translation[0], 4),
@@ -122,7 +115,7 @@ def _xyyaw(t: Transform3) -> list[float]:
     ]
 
 
-class VizBridge:
+class VizBridge(DisplayStatus):
     """Subscriptions and publishers of the dashboard in ``context``.
 
     Args:
@@ -503,79 +496,6 @@ class VizBridge:
                 for t in self.topics()
             ]
         return out
-
-    def status(
-        self, frames: dict[str, list[float]], outlines: list[VisualOutline]
-    ) -> dict[str, Any]:
-        """The status tree: ``{"global": [[level, name, text], ...], "displays": [...]}``."""
-        infos = {t.name: t for t in self.topics()}
-        want = self.config.fixed_frame
-        glob: list[list[str]] = []
-        if self.tf_buffer.has_frame(want):
-            glob.append(["ok", "Fixed Frame", "OK"])
-        elif self.fixed_frame != want:
-            glob.append(
-                ["warn", "Fixed Frame", f"Fixed Frame [{want}] does not exist; drawing in [odom]"]
-            )
-        else:
-            glob.append(["error", "Fixed Frame", f"Fixed Frame [{want}] does not exist"])
-        for item in self.config.unsupported:
-            glob.append(["warn", "Unsupported display", f"{item} is not supported; skipped"])
-        rows: list[list[list[str]]] = []
-        for d in self.displays:
-            cfg = d.config
-            entries: list[list[str]] = []
-            if not cfg.enabled:
-                rows.append([["disabled", "Status", "disabled"]])
-                continue
-            if d.sub_key[0]:
-                info = infos.get(cfg.topic)
-                types = DISPLAY_KINDS[cfg.kind].types
-                if info is not None and info.typename not in types:
-                    entries.append(
-                        ["error", "Topic", f"{cfg.topic} carries {info.typename}, not {types[0]}"]
-                    )
-                elif info is None or info.publishers == 0:
-                    text = f"No publisher on {cfg.topic}"
-                    if d.received:
-                        text += f" ({d.received} messages received)"
-                    entries.append(["warn", "Topic", text])
-                elif d.received == 0:
-                    entries.append(["warn", "Topic", f"No messages received on {cfg.topic}"])
-                else:
-                    entries.append(["ok", "Topic", f"{d.received} messages received"])
-            elif cfg.kind == "robot_model":
-                if not outlines:
-                    entries.append(["warn", "URDF", f"No robot description on {cfg.topic}"])
-                else:
-                    missing = sorted({o.link for o in outlines} - set(frames) - {self.fixed_frame})
-                    if missing:
-                        entries.append(
-                            ["error", "Transform", f"No transform for link(s) {', '.join(missing)}"]
-                        )
-                    else:
-                        entries.append(["ok", "URDF", f"{len(outlines)} visuals"])
-            elif cfg.kind == "grid":
-                ref = str(cfg.option("reference_frame"))
-                if ref and ref not in frames and ref != self.fixed_frame:
-                    entries.append(["error", "Transform", f"Frame [{ref}] does not exist"])
-                else:
-                    entries.append(["ok", "Status", "OK"])
-            elif cfg.kind == "tf":
-                entries.append(["ok", "Frames", f"{len(frames)} frames"])
-            frame = d.info.get("frame") if cfg.kind == "map" else None
-            if frame and frame not in frames and frame != self.fixed_frame:
-                entries.append(
-                    ["error", "Transform", f"No transform from [{frame}] to [{self.fixed_frame}]"]
-                )
-            elif frame:
-                entries.append(["ok", "Transform", "Transform OK"])
-            for name, (level, text) in d.status.items():
-                entries.append([level, name, text])
-            if d.error:
-                entries.append(["error", "Message", d.error])
-            rows.append(entries)
-        return {"global": glob, "displays": rows}
 
     # ------------------------------------------------------------------ tools
     def _header(self) -> dict[str, Any]:
