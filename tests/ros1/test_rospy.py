@@ -223,16 +223,52 @@ def test_shutdown_hooks_run_before_is_shutdown(node: Any) -> None:
 
 
 def test_rate_follows_sim_time(ros1: Any) -> None:
-    ctx = Context(clock="paced", rate=50.0)
+    # Paced at 10x: 2 s of sim time take 0.2 s of wall time. Following wall time instead
+    # would take 20 s of sim time, so a bound of 2.5 s still tells the two apart while
+    # leaving 50 ms of wall time for the last wake-up on a loaded machine.
+    ctx = Context(clock="paced", rate=10.0)
     RUNTIME.configure(ctx, [])
     ros1.init_node("looper", disable_signals=True)
+    start = ros1.get_rostime().to_nsec()
     rate = ros1.Rate(10)
-    start = ros1.get_time()
+    woke = []
     for _ in range(20):
         rate.sleep()
-    assert ros1.get_time() - start == pytest.approx(2.0, abs=0.15)  # 2 s of sim time
+        woke.append(ros1.get_rostime().to_nsec())
+    # never early: the k-th sleep ends at or after start + k periods of sim time
+    assert all(t >= start + (k + 1) * 100_000_000 for k, t in enumerate(woke))
+    assert (woke[-1] - start) / 1e9 < 2.5  # 2 s of sim time, not 20
     RUNTIME.signal_shutdown("done")
     ctx.shutdown()
+
+
+def test_rate_makes_up_a_late_wake_up(ros1: Any, monkeypatch: pytest.MonkeyPatch) -> None:
+    """As rospy.Rate: a sleep that wakes 3 periods late is made up by the next calls
+    returning at once, so the loop keeps its schedule (last + period), while a loop body
+    slower than 2 periods restarts the schedule from the time of the call."""
+    clock = [0]
+    overslept = []
+
+    def sleep_until(t_ns: int) -> None:
+        if clock[0] < t_ns:
+            late = 300_000_000 if not overslept else 0
+            overslept.append(late)
+            clock[0] = t_ns + late
+
+    monkeypatch.setattr(RUNTIME, "now_ns", lambda: clock[0])
+    monkeypatch.setattr(RUNTIME, "sleep_until", sleep_until)
+    rate = ros1.Rate(10)
+    woke = []
+    for _ in range(6):
+        rate.sleep()
+        woke.append(clock[0])
+    # woke at 0.4 (late), caught up at once through 0.2, 0.3, 0.4, then 0.5, 0.6 on time
+    assert woke == [400_000_000] * 4 + [500_000_000, 600_000_000]
+    clock[0] += 1_000_000_000  # a 1 s loop body: more than 2 periods behind
+    rate.sleep()
+    assert rate.last_ns == 1_600_000_000
+    rate.sleep()
+    assert clock[0] == 1_700_000_000
 
 
 def test_user_message_package_from_the_package_path(

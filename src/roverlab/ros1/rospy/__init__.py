@@ -204,14 +204,16 @@ class Rate:
         return Duration.from_nsec(self.last_ns + self.sleep_dur_ns - RUNTIME.now_ns())
 
     def sleep(self) -> None:
-        now = RUNTIME.now_ns()
-        if now < self.last_ns:  # time jumped back
-            self.last_ns = now
+        # As rospy: sleep until last + period, then judge "too slow" by the time of the
+        # call, so a late wake-up is made up by the next iterations (they return at once)
+        # instead of pushing the whole schedule back.
+        curr = RUNTIME.now_ns()
+        if curr < self.last_ns:  # time jumped back
+            self.last_ns = curr
         RUNTIME.sleep_until(self.last_ns + self.sleep_dur_ns)
         self.last_ns += self.sleep_dur_ns
-        now = RUNTIME.now_ns()
-        if now - self.last_ns > 2 * self.sleep_dur_ns:  # fell far behind: catch up
-            self.last_ns = now
+        if curr - self.last_ns > 2 * self.sleep_dur_ns:  # time jumped ahead / loop too slow
+            self.last_ns = curr
 
 
 class TimerEvent:

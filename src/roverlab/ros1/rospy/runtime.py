@@ -177,7 +177,14 @@ class Runtime:
             if now < start - 1_000_000_000:
                 raise ROSInterruptException("ROS time moved backwards")
             wait_s = (t_ns - now) / 1e9
-            time.sleep(min(wait_s, 0.01) if context.clock_mode is ClockMode.WALL else 0.002)
+            if context.clock_mode is ClockMode.WALL:
+                time.sleep(min(wait_s, 0.01))
+            elif context.clock_mode is ClockMode.PACED:
+                # the live paced clock runs at ex.rate x wall time: a fixed 2 ms poll would be
+                # a whole 10 Hz period at 50x
+                time.sleep(min(wait_s / ex.rate, 0.01))
+            else:
+                time.sleep(0.002)
 
     # ----------------------------------------------------------------- shutdown
     def signal_shutdown(self, reason: str) -> None:
