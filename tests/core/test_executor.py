@@ -167,6 +167,31 @@ def test_paced_mode_follows_wall_clock_times_rate() -> None:
     assert 0.15 <= ticks[9] - start <= 0.45
 
 
+def test_an_overloaded_paced_clock_waits_for_the_executor() -> None:
+    """Callbacks needing twice the CPU the pace allows: the clock other threads read (and
+    their wait_for deadlines) follows the time the executor has lived through, instead of
+    running ahead of it by a growing margin."""
+    ctx = Context(clock="paced", rate=2.0, publish_clock=False)
+    ticks: list[int] = []
+
+    def busy() -> None:
+        ticks.append(ctx.executor.now_ns)
+        time.sleep(0.1)  # 0.1 s of sim time paced at 2x is 0.05 s of wall time
+
+    ctx.create_node("t").create_timer(0.1, busy)
+    ctx.spin_in_thread()
+    try:
+        start = ctx.now().nanoseconds
+        assert not ctx.wait_for(lambda: False, 1.0)
+        done = [t for t in ticks if start < t <= start + 1_000_000_000]
+        # a clock running at the pace would end the wait after ~5 of the 10 periods
+        assert len(done) >= 8, (len(done), len(ticks))
+        lag = ctx.executor.clock_now_ns() - ctx.executor.now_ns
+        assert lag <= 300_000_000, lag  # 0.05 s of wall time at 2x, plus one period
+    finally:
+        ctx.shutdown()
+
+
 def test_publish_from_another_thread_is_queued_into_the_executor() -> None:
     ctx = Context(clock="wall")
     node = ctx.create_node("n")

@@ -7,7 +7,10 @@ Clock modes:
     waits on the wall clock, so a seeded run is reproducible bit for bit.
 ``paced``
     Simulated time that advances with the wall clock times ``rate`` (``rate=1`` is real
-    time). Callbacks scheduled at a time see exactly that time.
+    time). Callbacks scheduled at a time see exactly that time. When the callbacks need
+    more CPU than the pace allows, the clock waits for them (as Gazebo's real-time factor
+    drops): it never runs more than :data:`PACED_MAX_LAG_S` of wall time ahead of the
+    executor, so other threads' sim-time timeouts count time the simulation has lived.
 ``wall``
     The system clock (nanoseconds since the Unix epoch), for processes that talk to
     hardware or to other processes in real time.
@@ -36,6 +39,10 @@ from typing import Any
 __all__ = ["ClockMode", "Executor"]
 
 _INF = 1 << 62
+
+#: In ``paced`` mode, how far (wall seconds) the executor may fall behind the pace before
+#: the clock is re-anchored on it instead of running ahead.
+PACED_MAX_LAG_S = 0.05
 
 
 class ClockMode(Enum):
@@ -83,6 +90,7 @@ class Executor:
         self._sleeping = False
         self._stopped = False
         self._pace_origin: tuple[int, int] | None = None  # (sim ns, perf_counter ns)
+        self._max_lag_ns = round(PACED_MAX_LAG_S * 1e9 * rate) if mode is ClockMode.PACED else _INF
         self.on_error = on_error
         self.callback_errors = 0
         self.events_run = 0
@@ -293,6 +301,11 @@ class Executor:
                     if now >= target:
                         if next_t <= limit:
                             t = heap[0][0]
+                            if self.mode is ClockMode.PACED and now - t > self._max_lag_ns:
+                                # overloaded: the clock waits for the executor rather than
+                                # running ahead of it (what other threads read, their
+                                # wait_for deadlines) and making the executor burst
+                                self._pace_origin = (t, time.perf_counter_ns())
                             self.now_ns = max(
                                 self.now_ns, now if self.mode is ClockMode.WALL else t
                             )
