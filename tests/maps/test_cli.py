@@ -13,6 +13,7 @@ from typer.testing import CliRunner
 
 from roverlab.cli.maps import app
 from roverlab.maps import MapError, save_map
+from tests.helpers.nodes import run_main
 from tests.helpers.procs import Proc
 
 runner = CliRunner()
@@ -56,16 +57,21 @@ def test_info_bad_input_raises_map_error(tmp_path: Path) -> None:
     assert "bad.yaml: missing key 'origin'" in str(result.exception)
 
 
-def test_bad_input_is_one_line_and_exit_2(tmp_path: Path) -> None:
+def test_bad_input_is_one_line_and_exit_2(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capfd: pytest.CaptureFixture[str]
+) -> None:
+    # one real process (its whole stderr is the line), the other cases in this process
+    # (stdout and stderr captured at the file descriptors): each process costs an import
     proc = _run("info", "missing.yaml", cwd=tmp_path)
     assert proc.returncode == 2
     assert proc.stderr == "error: missing.yaml: map file not found\n"
-    proc = _run("save", "-f", "x", "--occ", "0", cwd=tmp_path)
-    assert proc.returncode == 2
-    assert proc.stderr.strip() == "error: threshold_occupied must be between 1 and 100, got 0"
-    proc = _run("server", "missing.yaml", cwd=tmp_path)
-    assert proc.returncode == 2
-    assert proc.stderr.strip().splitlines()[-1] == "error: missing.yaml: map file not found"
+    monkeypatch.chdir(tmp_path)
+    assert run_main(["map", "save", "-f", "x", "--occ", "0"]) == 2
+    err = capfd.readouterr().err
+    assert err.strip() == "error: threshold_occupied must be between 1 and 100, got 0"
+    assert run_main(["map", "server", "missing.yaml"]) == 2
+    err = capfd.readouterr().err
+    assert err.strip().splitlines()[-1] == "error: missing.yaml: map file not found"
     assert list(tmp_path.iterdir()) == []
 
 
