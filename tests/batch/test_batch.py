@@ -15,6 +15,7 @@ import pytest
 from roverlab.autonomy.explore_batch import explore_episode
 from roverlab.autonomy.explore_run import run_explore
 from roverlab.batch import BatchError, Episode, aggregate, estimate_hours, run_batch
+from tests.helpers.nodes import run_main
 
 CONFIG: dict[str, Any] = {
     "world": "maze", "robot": "mybot", "slam": "gmapping", "duration_s": 8.0,
@@ -26,15 +27,37 @@ def _without_wall(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
     return [{k: v for k, v in r.items() if k != "wall_s"} for r in rows]
 
 
-def test_episode_i_is_the_single_run_with_seed_s_plus_i() -> None:
-    done = run_batch(explore_episode, CONFIG, episodes=2, seed=5)
-    assert [e.row["seed"] for e in done] == [5, 6] and [e.row["episode"] for e in done] == [0, 1]
-    single = run_explore(world="maze", slam="gmapping", seed=6, duration_s=8.0).result.to_dict()
+def _explore_cli(out: Path, *extra: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", "roverlab.cli", *_explore_args(out), *extra],
+        capture_output=True, text=True, timeout=600,
+    )  # fmt: skip
+
+
+def _explore_args(out: Path) -> list[str]:
+    return ["explore", "--duration", "8", "--episodes", "3", "--seed", "2", "--out", str(out)]
+
+
+@pytest.fixture(scope="module")
+def serial_batch(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """``roverlab explore --episodes 3 --seed 2`` (serial): seeds 2, 3, 4. Run once for the
+    module, through the entry point in this process (a process would only add an import):
+    the single-run and the Ray tests both compare with it."""
+    out = tmp_path_factory.mktemp("serial")
+    assert run_main(_explore_args(out)) == 0
+    return out
+
+
+def test_episode_i_is_the_single_run_with_seed_s_plus_i(serial_batch: Path) -> None:
+    rows = json.loads((serial_batch / "episodes.json").read_text())["episodes"]
+    assert [r["seed"] for r in rows] == [2, 3, 4] and [r["episode"] for r in rows] == [0, 1, 2]
+    single = run_explore(world="maze", slam="gmapping", seed=3, duration_s=8.0).result.to_dict()
     single.pop("wall_s")
-    row = {k: v for k, v in done[1].row.items() if k not in ("wall_s", "episode")}
+    row = {k: v for k, v in rows[1].items() if k not in ("wall_s", "episode")}
     assert row == single
-    assert done[0].row["distance_m"] > 0.5  # the robot explored
-    assert {"map.png", "map.yaml", "map.pgm", "coverage.png", "summary.json"} <= set(done[0].files)
+    assert rows[0]["distance_m"] > 0.5  # the robot explored
+    files = {p.name for p in (serial_batch / "episode_000").iterdir()}
+    assert {"map.png", "map.yaml", "map.pgm", "coverage.png", "summary.json"} <= files
 
 
 def test_a_failing_episode_is_a_row_with_its_error_and_the_batch_goes_on() -> None:
@@ -76,22 +99,12 @@ def test_aggregate_and_estimate() -> None:
     assert math.isnan(estimate_hours([], 10, 1))
 
 
-def _explore_cli(out: Path, *extra: str) -> subprocess.CompletedProcess[str]:
-    args = ["explore", "--duration", "8", "--episodes", "3", "--seed", "2", "--out", str(out)]
-    return subprocess.run(
-        [sys.executable, "-m", "roverlab.cli", *args, *extra],
-        capture_output=True, text=True, timeout=600,
-    )  # fmt: skip
-
-
-def test_cli_serial_and_ray_give_the_same_episodes(tmp_path: Path) -> None:
+def test_cli_serial_and_ray_give_the_same_episodes(serial_batch: Path, tmp_path: Path) -> None:
     pytest.importorskip("ray", reason="the 'ray' extra is not installed")
-    serial = _explore_cli(tmp_path / "serial")
-    assert serial.returncode == 0, serial.stderr
     parallel = _explore_cli(tmp_path / "ray", "--workers", "2")
     assert parallel.returncode == 0, parallel.stderr
     assert "batch: 3/3 episodes" in parallel.stdout and "2 worker(s), 0 failed" in parallel.stdout
-    a = json.loads((tmp_path / "serial" / "episodes.json").read_text())
+    a = json.loads((serial_batch / "episodes.json").read_text())
     b = json.loads((tmp_path / "ray" / "episodes.json").read_text())
     assert [r["seed"] for r in b["episodes"]] == [2, 3, 4]
     assert _without_wall(a["episodes"]) == _without_wall(b["episodes"])
@@ -105,10 +118,10 @@ def test_cli_serial_and_ray_give_the_same_episodes(tmp_path: Path) -> None:
     assert (tmp_path / "ray" / "episodes.png").stat().st_size > 1000
 
 
-def test_cli_refuses_a_paced_batch(tmp_path: Path) -> None:
-    r = _explore_cli(tmp_path, "--rate", "2")
-    assert r.returncode == 2
-    assert r.stderr.strip().splitlines()[-1].endswith("--episodes/--workers run at --rate max only")
+def test_cli_refuses_a_paced_batch(tmp_path: Path, capfd: pytest.CaptureFixture[str]) -> None:
+    assert run_main([*_explore_args(tmp_path), "--rate", "2"]) == 2
+    err = capfd.readouterr().err
+    assert err.strip().splitlines()[-1].endswith("--episodes/--workers run at --rate max only")
 
 
 def test_nav_bench_episodes_are_its_single_runs(tmp_path: Path) -> None:
@@ -120,11 +133,8 @@ def test_nav_bench_episodes_are_its_single_runs(tmp_path: Path) -> None:
     assert batch.returncode == 0, batch.stderr
     rows = json.loads((tmp_path / "b" / "episodes.json").read_text())["episodes"]
     assert [r["seed"] for r in rows] == [3, 4] and all(r["goals"] == 1 for r in rows)
-    single = subprocess.run(
-        [sys.executable, "-m", "roverlab.cli", *args[:-3], "--seed", "4", "--out",
-         str(tmp_path / "s")], capture_output=True, text=True, timeout=600,
-    )  # fmt: skip
-    assert single.returncode == 0, single.stderr
+    # the single run through the entry point in this process (a process adds an import)
+    assert run_main([*args[:-3], "--seed", "4", "--out", str(tmp_path / "s")]) == 0
     one = json.loads((tmp_path / "s" / "bench.json").read_text())
     timing = ("wall", "_ms", "map", "machine")
     assert {k: v for k, v in one.items() if k in rows[1] and not any(t in k for t in timing)} == {
