@@ -76,18 +76,22 @@ def test_list_info_node_and_hz(node_proc: Any, cli: Any) -> None:
     assert rates and 40.0 <= rates[-1] <= 60.0  # published at 50 Hz
 
 
-def test_param_get_set_dump(node_proc: Any, cli: Any) -> None:
+def test_param_get_set_dump(node_proc: Any, cli: Any, capfd: pytest.CaptureFixture[str]) -> None:
     node_proc("pong")
     assert cli("param", "get", "/proc_pong", "gain").stdout.strip() == "1.5"
-    r = cli("param", "set", "/proc_pong", "gain", "2.5")
-    assert r.returncode == 0 and "successful" in r.stdout
-    dumped = yaml.safe_load(cli("param", "dump", "proc_pong").stdout)
+    # the other commands in this process (output captured at the file descriptors): the
+    # node is still in its own process, each command its own Zenoh session
+    capfd.readouterr()
+    assert run_main(["param", "set", "/proc_pong", "gain", "2.5"]) == 0
+    assert "successful" in capfd.readouterr().out
+    assert run_main(["param", "dump", "proc_pong"]) == 0
+    dumped = yaml.safe_load(capfd.readouterr().out)
     assert dumped["/proc_pong"]["ros__parameters"]["gain"] == 2.5
-    r = cli("param", "set", "/proc_pong", "gain", "fast")
-    assert r.returncode == 2
-    assert len(r.stderr.strip().splitlines()) == 1 and "type double" in r.stderr
-    r = cli("param", "get", "/proc_pong", "gian")
-    assert r.returncode == 2 and "did you mean 'gain'" in r.stderr
+    assert run_main(["param", "set", "/proc_pong", "gain", "fast"]) == 2
+    err = capfd.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and "type double" in err, err
+    assert run_main(["param", "get", "/proc_pong", "gian"]) == 2
+    assert "did you mean 'gain'" in capfd.readouterr().err
 
 
 def test_a_topic_command_does_not_import_the_stack() -> None:
