@@ -24,8 +24,10 @@ lint: install
 	$(VENV)/bin/mypy
 
 ## Install, then run the linters and the whole test suite.
+# Two pytest workers (pytest-xdist), a test file per worker so module fixtures run once:
+# many tests wait on the processes they start, and CI has 2 cores and 20 minutes.
 test: lint
-	$(VENV)/bin/pytest -q
+	$(VENV)/bin/pytest -q -n 2 --dist loadfile
 
 bench: install
 	$(PY) -m pip install -q -e '.[bench]'
