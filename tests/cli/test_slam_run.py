@@ -16,7 +16,9 @@ DATA = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "radish"
 
 
 @pytest.mark.skipif(not (DATA / "intel.clf.bz2").is_file(), reason="shared/data/radish is absent")
-def test_hector_on_an_intel_slice_writes_map_trajectory_and_scores(tmp_path: Path) -> None:
+def test_hector_on_an_intel_slice_writes_map_trajectory_and_scores(
+    tmp_path: Path, capfd: pytest.CaptureFixture[str]
+) -> None:
     out = tmp_path / "run"
     r = subprocess.run(
         [sys.executable, "-m", "roverlab.cli", "slam", "run", str(DATA / "intel.clf.bz2"),
@@ -28,7 +30,7 @@ def test_hector_on_an_intel_slice_writes_map_trajectory_and_scores(tmp_path: Pat
         assert (out / name).is_file()
     lines = (out / "trajectory.tum").read_text().splitlines()
     assert len(lines) == 1500 and lines[0].split()[0] == "976052857.337530"
-    trans = _translational_error(out / "trajectory.tum", DATA / "intel.relations")
+    trans = _translational_error(out / "trajectory.tum", DATA / "intel.relations", capfd)
     assert trans < 0.05  # the slice's relations (the full log scores 0.021 m)
 
 
@@ -43,7 +45,9 @@ def test_unknown_method_is_one_line_exit_2(tmp_path: Path) -> None:
 
 
 @pytest.mark.skipif(not (DATA / "intel.clf.bz2").is_file(), reason="shared/data/radish is absent")
-def test_gmapping_on_an_intel_slice_is_seeded_and_scores(tmp_path: Path) -> None:
+def test_gmapping_on_an_intel_slice_is_seeded_and_scores(
+    tmp_path: Path, capfd: pytest.CaptureFixture[str]
+) -> None:
     def run(out: Path, seed: int) -> str:
         r = subprocess.run(
             [sys.executable, "-m", "roverlab.cli", "slam", "run", str(DATA / "intel.clf.bz2"),
@@ -59,7 +63,7 @@ def test_gmapping_on_an_intel_slice_is_seeded_and_scores(tmp_path: Path) -> None
     lines = a.splitlines()
     assert len(lines) == 700 and lines[0].split()[0] == "976052857.337530"
     assert (tmp_path / "a" / "map.pgm").is_file() and (tmp_path / "a" / "map.png").is_file()
-    trans = _translational_error(tmp_path / "a" / "trajectory.tum", DATA / "intel.relations")
+    trans = _translational_error(tmp_path / "a" / "trajectory.tum", DATA / "intel.relations", capfd)
     assert trans < 0.08
 
 
@@ -117,7 +121,7 @@ def test_hector_grows_its_map_when_the_log_has_no_odometry() -> None:
 
 
 @pytest.mark.skipif(not (DATA / "intel.clf.bz2").is_file(), reason="shared/data/radish is absent")
-def test_graph_on_an_intel_slice_scores(tmp_path: Path) -> None:
+def test_graph_on_an_intel_slice_scores(tmp_path: Path, capfd: pytest.CaptureFixture[str]) -> None:
     out = tmp_path / "g"
     r = subprocess.run(
         [sys.executable, "-m", "roverlab.cli", "slam", "run", str(DATA / "intel.clf.bz2"),
@@ -127,7 +131,7 @@ def test_graph_on_an_intel_slice_scores(tmp_path: Path) -> None:
     assert r.returncode == 0, r.stderr
     assert "graph: " in r.stderr and "keyframes" in r.stderr
     assert len((out / "trajectory.tum").read_text().splitlines()) == 1000
-    assert _translational_error(out / "trajectory.tum", DATA / "intel.relations") < 0.05
+    assert _translational_error(out / "trajectory.tum", DATA / "intel.relations", capfd) < 0.05
 
 
 def test_graph_parameter_errors_come_before_reading_the_log(tmp_path: Path) -> None:
