@@ -150,7 +150,7 @@ def test_tf_echo_and_frames_against_the_simulator(daemon: str, cli: Any) -> None
         z = (~links["base_footprint"] * links["base_laser_link"]).translation[2]
         translation = r.stdout.split("- Translation: [")[1].split("]")[0]
         assert abs(float(translation.split(",")[2]) - z) < 1e-3
-        r = cli("tf", "frames", "--wait", "2")
+        r = cli("tf", "frames", "--wait", "5")  # view_frames listens 5 s; 2 s flaked under load
         assert r.returncode == 0, r.stderr
         for frame in ("odom", "base_footprint", "base_link", "base_laser_link"):
             assert frame in r.stdout
