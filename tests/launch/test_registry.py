@@ -4,12 +4,11 @@
 from __future__ import annotations
 
 import importlib
-import subprocess
-import sys
 
 from roverlab.core import Node
 from roverlab.launch.devices import DEVICE_NODES
 from roverlab.launch.registry import _NODES
+from tests.helpers.imports import loaded_after
 
 
 def test_every_lazily_named_node_class_exists() -> None:
@@ -27,14 +26,7 @@ def test_every_lazily_named_node_class_exists() -> None:
 
 
 def test_importing_the_registry_loads_no_algorithm_node() -> None:
-    code = (
-        "import sys\n"
-        "import roverlab.launch.registry\n"
-        "mods = ('roverlab.navigation.move_base.node', 'roverlab.slam.gmapping.node',\n"
-        "        'roverlab.localization.amcl.node', 'roverlab.perception.face_detector.node',\n"
-        "        'fastapi')\n"
-        "print([m for m in mods if m in sys.modules])\n"
-    )
-    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
-    assert r.returncode == 0, r.stderr
-    assert r.stdout.strip() == "[]"
+    nodes = ("roverlab.navigation.move_base.node", "roverlab.slam.gmapping.node",
+             "roverlab.localization.amcl.node", "roverlab.perception.face_detector.node",
+             "fastapi")  # fmt: skip
+    assert loaded_after("import roverlab.launch.registry", nodes) == []
