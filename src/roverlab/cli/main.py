@@ -17,7 +17,7 @@ from roverlab.cli.common import NetworkOptions
 # The subcommands, in the order ``roverlab --help`` lists them: name -> (module, attribute).
 # A command's module is imported only when that command runs (or the root help lists them
 # all), so ``roverlab topic echo`` does not pay for the simulator, the planners and the web
-# server: about 0.7 s to start instead of 3-4 s on a 2-core machine.
+# server: about 1 s to start instead of 3-4 s on a 2-core machine.
 _COMMANDS: dict[str, tuple[str, str]] = {
     "demo": ("roverlab.cli.demo", "demo"),
     "sim": ("roverlab.cli.sim", "sim"),

@@ -18,9 +18,8 @@ from typing import Final
 from roverlab.core import Node
 from roverlab.drivers.arbotix.node import ArbotixDriver
 from roverlab.drivers.serial_base.node import ArduinoBaseNode
-from roverlab.errors import RoverlabError
-from roverlab.launch.state import LaunchState, NodeFactory, node_factory, node_kwargs
-from roverlab.launch.xml import LaunchError, NodeSpec
+from roverlab.launch.state import LaunchState, NodeFactory, build_node, node_factory
+from roverlab.launch.xml import NodeSpec
 
 __all__ = ["DEVICE_NODES"]
 
@@ -32,10 +31,7 @@ def _arbotix(state: LaunchState, spec: NodeSpec) -> Node | None:
             "is supported; a real ArbotiX board's protocol is not implemented"
         )
         return None
-    try:
-        return ArbotixDriver(state.context, node_name=spec.name, **node_kwargs(spec))
-    except (RoverlabError, ValueError) as err:
-        raise LaunchError(f"{spec.source}: {spec.pkg}/{spec.type}: {err}") from err
+    return build_node(state, spec, ArbotixDriver)
 
 
 ROBORTS_BASE_KEYS: Final = (
@@ -72,11 +68,7 @@ def _roborts_base(state: LaunchState, spec: NodeSpec) -> Node:
         if key not in params and glob in state.params:
             params[key] = state.params[glob]
     params.setdefault("use_base_controller", True)
-    kwargs = {**node_kwargs(spec), "parameter_overrides": params}
-    try:
-        return ArduinoBaseNode(state.context, node_name=spec.name, **kwargs)
-    except (RoverlabError, ValueError) as err:
-        raise LaunchError(f"{spec.source}: {spec.pkg}/{spec.type}: {err}") from err
+    return build_node(state, spec, ArduinoBaseNode, parameter_overrides=params)
 
 
 _SERIAL_BASE = "roverlab.drivers.serial_base.node:ArduinoBaseNode"

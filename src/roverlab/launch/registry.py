@@ -18,7 +18,7 @@ from roverlab.description import load_robot
 from roverlab.description.node import JointStatePublisher, RobotStatePublisher
 from roverlab.geometry import quat_from_rpy
 from roverlab.launch.devices import DEVICE_NODES
-from roverlab.launch.state import LaunchState, NodeFactory, node_factory
+from roverlab.launch.state import LaunchState, NodeFactory, node_factory, node_kwargs
 from roverlab.launch.xml import LaunchError, NodeSpec
 from roverlab.maps.node import MapSaver, MapServer
 from roverlab.msgs import classes as mc
@@ -49,14 +49,6 @@ def load_plugins() -> None:
     for ep in entry_points(group="roverlab.nodes"):
         pkg, _, type_ = ep.name.partition("/")
         register(pkg, type_)(ep.load())
-
-
-def _kwargs(spec: NodeSpec) -> dict[str, Any]:
-    return {
-        "namespace": spec.namespace,
-        "parameter_overrides": spec.params,
-        "remappings": spec.remaps,
-    }
 
 
 def _description(state: LaunchState, spec: NodeSpec) -> str | None:
@@ -100,13 +92,13 @@ def _with_description(make: Callable[[LaunchState, NodeSpec, str], Node]) -> Nod
 
 def _make_rsp(state: LaunchState, spec: NodeSpec, urdf: str) -> Node:
     return RobotStatePublisher(
-        state.context, robot_description=urdf, node_name=spec.name, **_kwargs(spec)
+        state.context, robot_description=urdf, node_name=spec.name, **node_kwargs(spec)
     )
 
 
 def _make_jsp(state: LaunchState, spec: NodeSpec, urdf: str) -> Node:
     return JointStatePublisher(
-        state.context, robot_description=urdf, node_name=spec.name, **_kwargs(spec)
+        state.context, robot_description=urdf, node_name=spec.name, **node_kwargs(spec)
     )
 
 
@@ -123,7 +115,7 @@ def _make_jsp_gui(state: LaunchState, spec: NodeSpec, urdf: str) -> Node:
     sources = list(spec.params.get("source_list") or [])
     if SLIDER_TOPIC not in sources:
         sources.append(SLIDER_TOPIC)
-    kwargs = {**_kwargs(spec), "parameter_overrides": {**spec.params, "source_list": sources}}
+    kwargs = {**node_kwargs(spec), "parameter_overrides": {**spec.params, "source_list": sources}}
     return JointStatePublisher(state.context, robot_description=urdf, node_name=spec.name, **kwargs)
 
 
@@ -206,7 +198,7 @@ def _static_tf(state: LaunchState, spec: NodeSpec) -> Node:
         source=spec.source,
         pkg=spec.pkg,
         node_name=spec.name,
-        **_kwargs(spec),
+        **node_kwargs(spec),
     )
 
 
@@ -268,7 +260,7 @@ def _map_server(state: LaunchState, spec: NodeSpec) -> Node:
     argv = shlex.split(spec.args)
     if len(argv) != 1:
         raise LaunchError(f"{spec.source}: map_server takes one argument, the map's YAML file")
-    return MapServer(state.context, yaml_path=argv[0], node_name=spec.name, **_kwargs(spec))
+    return MapServer(state.context, yaml_path=argv[0], node_name=spec.name, **node_kwargs(spec))
 
 
 @register("map_server", "map_saver")
@@ -280,7 +272,7 @@ def _map_saver(state: LaunchState, spec: NodeSpec) -> Node:
         if i + 1 >= len(argv):
             raise LaunchError(f"{spec.source}: map_saver -f needs a file name")
         prefix = argv[i + 1]
-    return MapSaver(state.context, path_prefix=prefix, node_name=spec.name, **_kwargs(spec))
+    return MapSaver(state.context, path_prefix=prefix, node_name=spec.name, **node_kwargs(spec))
 
 
 # The algorithm nodes, imported when a launch first starts one.

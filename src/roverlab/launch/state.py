@@ -11,7 +11,7 @@ from roverlab.core import Context, Node
 from roverlab.errors import RoverlabError
 from roverlab.launch.xml import LaunchError, NodeSpec
 
-__all__ = ["LaunchState", "NodeFactory", "node_factory", "node_kwargs"]
+__all__ = ["LaunchState", "NodeFactory", "build_node", "node_factory", "node_kwargs"]
 
 
 @dataclass
@@ -41,6 +41,24 @@ def node_kwargs(spec: NodeSpec) -> dict[str, Any]:
     }
 
 
+def build_node(
+    state: LaunchState,
+    spec: NodeSpec,
+    make: Callable[..., Node],
+    parameter_overrides: dict[str, Any] | None = None,
+) -> Node:
+    """``make(context, node_name=..., **node_kwargs(spec))`` (with ``parameter_overrides``
+    in place of the ``<node>``'s own when given); a bad configuration is a LaunchError
+    naming the file and the node."""
+    kwargs = node_kwargs(spec)
+    if parameter_overrides is not None:
+        kwargs["parameter_overrides"] = parameter_overrides
+    try:
+        return make(state.context, node_name=spec.name, **kwargs)
+    except (RoverlabError, ValueError) as err:
+        raise LaunchError(f"{spec.source}: {spec.pkg}/{spec.type}: {err}") from err
+
+
 def node_factory(path: str) -> NodeFactory:
     """The factory of a plain node: the class at ``"module:Class"`` built from its
     ``<node>`` (private parameters, remaps); a bad configuration is a LaunchError naming
@@ -49,11 +67,6 @@ def node_factory(path: str) -> NodeFactory:
     module, _, name = path.partition(":")
 
     def factory(state: LaunchState, spec: NodeSpec) -> Node:
-        make = getattr(importlib.import_module(module), name)
-        try:
-            node: Node = make(state.context, node_name=spec.name, **node_kwargs(spec))
-        except (RoverlabError, ValueError) as err:
-            raise LaunchError(f"{spec.source}: {spec.pkg}/{spec.type}: {err}") from err
-        return node
+        return build_node(state, spec, getattr(importlib.import_module(module), name))
 
     return factory
