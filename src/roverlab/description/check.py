@@ -44,6 +44,12 @@ def robot_warnings(model: RobotModel) -> list[str]:
     sensors = list(dict.fromkeys(s.type for s in model.gazebo.unsupported_sensors))
     if plugins:
         out.append(f"{src}: Gazebo plugins not simulated (ignored): {', '.join(plugins)}")
+    if "libgazebo_ros_control.so" in plugins:
+        out.append(
+            f"{src}: libgazebo_ros_control.so: ros_control controllers (diff_drive_controller, "
+            "joint_state_controller) are not run, so nothing moves the robot on cmd_vel; "
+            "add a libgazebo_ros_diff_drive.so or libgazebo_ros_skid_steer_drive.so plugin"
+        )
     if sensors:
         out.append(f"{src}: Gazebo sensor types not simulated (ignored): {', '.join(sensors)}")
     out += _shape_warnings(model)
@@ -160,8 +166,11 @@ def _plugin_line(p: GazeboPlugin) -> str:
     head = f"  {p.name or '(unnamed)'} [{p.filename}] on {owner}"
     spec = p.spec
     if isinstance(spec, DiffDriveSpec):
+        joints = f"{spec.left_joint}/{spec.right_joint}"
+        if spec.rear_joints is not None:
+            joints += f" + {spec.rear_joints[0]}/{spec.rear_joints[1]}"
         detail = (
-            f": {spec.left_joint}/{spec.right_joint}, separation "
+            f": {joints}, separation "
             f"{_num(spec.wheel_separation_m)} m, diameter {_num(spec.wheel_diameter_m)} m, "
             f"{spec.command_topic} -> {spec.odometry_topic} "
             f"({spec.odometry_frame} -> {spec.robot_base_frame})"
@@ -181,6 +190,8 @@ def _plugin_line(p: GazeboPlugin) -> str:
             detail += ", " + _imu_noise(spec.noise)
         if spec.gaussian_noise:
             detail += f", gaussianNoise {_num(spec.gaussian_noise)}"
+        if p.filename == "libgazebo_ros_imu_sensor.so":  # its 1 Hz default surprises
+            detail += f", {_num(spec.update_rate_hz)} Hz" if spec.update_rate_hz else ""
     else:
         detail = ": not supported by roverlab (ignored)"
     return head + detail

@@ -60,9 +60,10 @@ __all__ = ["PLUGIN_SPECS", "parse_gazebo"]
 class _Values:
     """Typed reads of child-element text, errors naming ``where``."""
 
-    def __init__(self, values: Mapping[str, str], where: str) -> None:
+    def __init__(self, values: Mapping[str, str], where: str, model_name: str = "") -> None:
         self.values = values
         self.where = where
+        self.model_name = model_name
 
     def fail(self, key: str, problem: str) -> URDFError:
         return URDFError(f"{self.where}: <{key}>: {problem}")
@@ -278,6 +279,36 @@ def _diff_drive(v: _Values, plugin: GazeboPlugin) -> DiffDriveSpec:
     return spec
 
 
+def _skid_steer(v: _Values, plugin: GazeboPlugin) -> DiffDriveSpec:
+    """``libgazebo_ros_skid_steer_drive.so``: four wheels, the diff drive's kinematics;
+    odometry is always the model's world pose, the odom transform only with
+    ``broadcastTF`` (default false), ``torque`` (not ``wheelTorque``) on each wheel."""
+    ns = v.text("robotNamespace", "")
+    spec = DiffDriveSpec(
+        command_topic=resolve_topic(ns, v.text("commandTopic", "cmd_vel")),
+        odometry_topic=resolve_topic(ns, v.text("odometryTopic", "odom")),
+        odometry_frame=resolve_frame(ns, v.text("odometryFrame", "odom")),
+        robot_base_frame=resolve_frame(ns, v.text("robotBaseFrame", "base_footprint")),
+        publish_odom_tf=v.flag("broadcastTF", False),
+        odometry_source="world",
+        wheel_separation_m=v.non_negative("wheelSeparation", 0.4),
+        wheel_diameter_m=v.non_negative("wheelDiameter", 0.15),
+        wheel_torque_nm=v.non_negative("torque", 5.0),
+        update_rate_hz=v.non_negative("updateRate", 100.0),
+        left_joint=v.text("leftFrontJoint", "left_front_joint"),
+        right_joint=v.text("rightFrontJoint", "right_front_joint"),
+        rear_joints=(
+            v.text("leftRearJoint", "left_rear_joint"),
+            v.text("rightRearJoint", "right_rear_joint"),
+        ),
+        legacy_mode=False,
+        robot_namespace=ns,
+    )
+    if spec.wheel_separation_m <= 0 or spec.wheel_diameter_m <= 0:
+        raise v.fail("wheelSeparation", "wheelSeparation and wheelDiameter must be > 0")
+    return spec
+
+
 def _laser(v: _Values, plugin: GazeboPlugin) -> LaserPluginSpec:
     ns = v.text("robotNamespace", "")
     return LaserPluginSpec(
@@ -360,22 +391,53 @@ def _imu_plugin(v: _Values, plugin: GazeboPlugin, elem: ET.Element) -> ImuPlugin
     )
 
 
+def _imu_sensor_plugin(v: _Values, plugin: GazeboPlugin, elem: ET.Element) -> ImuPluginSpec:
+    """``libgazebo_ros_imu_sensor.so`` (noetic): the sensor's own measurements (with its
+    ``<imu>`` noise, filled in by ``_sensor``) plus ``gaussianNoise``, at ``updateRateHZ``
+    (default 1 Hz), on ``<robotNamespace>/<topicName>`` (default namespace: the model's
+    name, default topic ``imu_data``); ``frameName`` is required."""
+    if plugin.reference is None or plugin.link is None:
+        raise URDFError(
+            f"{v.where}: a sensor plugin: Gazebo loads it only inside "
+            "<gazebo reference='link'><sensor type='imu'>"
+        )
+    ns = v.text("robotNamespace", "") if "robotNamespace" in v.values else "/" + v.model_name
+    frame = v.text("frameName", "")
+    if not frame:
+        raise v.fail("frameName", "missing (Gazebo does not load the plugin without it)")
+    return ImuPluginSpec(
+        body_name=plugin.link,
+        frame_id=frame.lstrip("/"),
+        topic=resolve_topic(ns, v.text("topicName", "imu_data")),
+        service="",
+        gaussian_noise=v.non_negative("gaussianNoise", 0.0),
+        update_rate_hz=v.non_negative("updateRateHZ", 1.0),
+        xyz_offset=v.vector("xyzOffset", (0.0, 0.0, 0.0)),
+        rpy_offset=v.vector("rpyOffset", (0.0, 0.0, 0.0)),
+        robot_namespace=ns,
+    )
+
+
 _SpecParser = Callable[[_Values, GazeboPlugin, ET.Element], PluginSpec]
 
 PLUGIN_SPECS: Final[Mapping[str, _SpecParser]] = MappingProxyType(
     {
         "libgazebo_ros_diff_drive.so": lambda v, p, e: _diff_drive(v, p),
+        "libgazebo_ros_skid_steer_drive.so": lambda v, p, e: _skid_steer(v, p),
         "libgazebo_ros_laser.so": lambda v, p, e: _laser(v, p),
         "libgazebo_ros_gpu_laser.so": lambda v, p, e: _laser(v, p),
         "libgazebo_ros_camera.so": lambda v, p, e: _camera_plugin(v, p),
         "libgazebo_ros_openni_kinect.so": lambda v, p, e: _kinect(v, p),
         "libgazebo_ros_imu.so": _imu_plugin,
+        "libgazebo_ros_imu_sensor.so": _imu_sensor_plugin,
     }
 )
 """Plugin filenames roverlab understands -> parser of their typed spec."""
 
 
-def _plugin(elem: ET.Element, where: str, sensor: str | None, link: str | None) -> GazeboPlugin:
+def _plugin(
+    elem: ET.Element, where: str, sensor: str | None, link: str | None, model_name: str
+) -> GazeboPlugin:
     name = elem.get("name", "")
     filename = elem.get("filename", "")
     label = f"{where}: <plugin name='{name}' filename='{filename}'>"
@@ -391,7 +453,7 @@ def _plugin(elem: ET.Element, where: str, sensor: str | None, link: str | None) 
     parser = PLUGIN_SPECS.get(filename)
     if parser is None:
         return plugin
-    spec = parser(_Values(plugin.params, label), plugin, elem)
+    spec = parser(_Values(plugin.params, label, model_name), plugin, elem)
     return GazeboPlugin(plugin.name, filename, sensor, link, plugin.params, spec)
 
 
@@ -400,7 +462,19 @@ _SENSOR_KEYS: Final = frozenset(
 )
 
 
-def _sensor(elem: ET.Element, link: str, where: str) -> GazeboSensor:
+def _sensor_imu_plugin(plugin: GazeboPlugin, imu: ImuSpec | None, rate: float) -> GazeboPlugin:
+    """An imu sensor plugin measures what its sensor measures: the sensor's noise, and
+    no faster than the sensor updates (``rate`` 0: every physics step)."""
+    spec = plugin.spec
+    if plugin.filename != "libgazebo_ros_imu_sensor.so" or not isinstance(spec, ImuPluginSpec):
+        return plugin
+    hz = spec.update_rate_hz
+    if rate > 0:
+        hz = min(hz, rate) if hz > 0 else rate
+    return replace(plugin, spec=replace(spec, noise=imu, update_rate_hz=hz))
+
+
+def _sensor(elem: ET.Element, link: str, where: str, model_name: str) -> GazeboSensor:
     name = elem.get("name", "")
     stype = elem.get("type", "")
     label = f"{where}: <sensor name='{name}' type='{stype}'>"
@@ -419,13 +493,18 @@ def _sensor(elem: ET.Element, link: str, where: str) -> GazeboSensor:
         camera = _camera(cam_elem if cam_elem is not None else ET.Element("camera"), label)
     elif stype == "imu":
         imu = _imu_noise(elem.find("imu"), label) or ImuSpec()
-    plugins = tuple(_plugin(p, label, name, link) for p in elem.findall("plugin"))
+    plugins = tuple(_plugin(p, label, name, link, model_name) for p in elem.findall("plugin"))
+    rate = v.non_negative("update_rate", 0.0)
+    if stype == "imu":
+        plugins = tuple(_sensor_imu_plugin(p, imu, rate) for p in plugins)
+    elif any(p.filename == "libgazebo_ros_imu_sensor.so" for p in plugins):
+        raise URDFError(f"{label}: libgazebo_ros_imu_sensor.so needs a sensor of type 'imu'")
     return GazeboSensor(
         name=name,
         type=stype,
         reference_link=link,
         pose=_pose(simple.get("pose"), label),
-        update_rate_hz=v.non_negative("update_rate", 0.0),
+        update_rate_hz=rate,
         always_on=v.flag("always_on", False),
         visualize=v.flag("visualize", False),
         ray=ray,
@@ -472,8 +551,13 @@ def _reference(name: str, values: dict[str, str], where: str) -> GazeboReference
     )
 
 
-def parse_gazebo(elements: Iterable[ET.Element], source: str) -> GazeboExtensions:
+def parse_gazebo(
+    elements: Iterable[ET.Element], source: str, *, model_name: str = ""
+) -> GazeboExtensions:
     """Read the top-level ``<gazebo>`` elements of a URDF, in document order.
+
+    ``model_name`` (the ``<robot name>``, which is the Gazebo model's name when spawned
+    with ``-model`` the same) is the default namespace of plugins that use it.
 
     Raises:
         URDFError: a malformed value, naming ``source`` and the element.
@@ -491,11 +575,11 @@ def parse_gazebo(elements: Iterable[ET.Element], source: str) -> GazeboExtension
             if child.tag == "sensor":
                 if not ref:
                     raise URDFError(f"{where}: a <sensor> needs <gazebo reference='link'>")
-                sensor = _sensor(child, ref, where)
+                sensor = _sensor(child, ref, where, model_name)
                 sensors.append(sensor)
                 plugins.extend(sensor.plugins)
             elif child.tag == "plugin":
-                plugins.append(_plugin(child, where, None, ref))
+                plugins.append(_plugin(child, where, None, ref, model_name))
             elif not len(child):
                 target = ref_values.setdefault(ref, {}) if ref else model_params
                 target[child.tag] = (child.text or "").strip()

@@ -191,7 +191,9 @@ class ImuSpec:
 
 @dataclass(frozen=True, slots=True)
 class DiffDriveSpec:
-    """``libgazebo_ros_diff_drive.so`` with gazebo_ros' defaults for missing elements.
+    """``libgazebo_ros_diff_drive.so`` with gazebo_ros' defaults for missing elements, or
+    ``libgazebo_ros_skid_steer_drive.so`` (four wheels, the same kinematics; see
+    :attr:`rear_joints`).
 
     Topics are absolute, frames carry the tf prefix. ``wheel_acceleration`` is the limit
     on the change of wheel surface speed per second (m/s^2; 0: unlimited), as the plugin
@@ -217,6 +219,14 @@ class DiffDriveSpec:
     right_joint: str = "right_joint"
     legacy_mode: bool = True
     robot_namespace: str = ""
+    rear_joints: tuple[str, str] | None = None
+    """``leftRearJoint``/``rightRearJoint`` of ``libgazebo_ros_skid_steer_drive.so``
+    (None for the two-wheel diff drive); the front pair is ``left_joint``/``right_joint``."""
+
+    @property
+    def wheel_count(self) -> int:
+        """Wheels the plugin drives (each with ``wheel_torque_nm``): 2, or 4 skid-steered."""
+        return 2 if self.rear_joints is None else 4
 
     @property
     def wheel_radius_m(self) -> float:
@@ -280,9 +290,13 @@ class KinectPluginSpec:
 
 @dataclass(frozen=True, slots=True)
 class ImuPluginSpec:
-    """``libgazebo_ros_imu.so`` (a model plugin reading the pose of link ``body_name``).
+    """``libgazebo_ros_imu.so`` (a model plugin reading the pose of link ``body_name``), or
+    ``libgazebo_ros_imu_sensor.so`` (a plugin of an ``imu`` sensor: ``body_name`` is the
+    sensor's link).
 
-    ``noise`` is the plugin's ``<imu><noise>`` block when it has one (as bingda's mybot).
+    ``noise`` is the plugin's ``<imu><noise>`` block when it has one (as bingda's mybot);
+    for the sensor plugin it is the sensor's own ``<imu>`` noise. ``update_rate_hz`` 0
+    means every physics step.
     """
 
     body_name: str

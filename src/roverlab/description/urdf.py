@@ -356,7 +356,7 @@ def parse_urdf(xml_text: str, *, source: str = "<string>") -> RobotModel:
             )
     links = {e.get("name", ""): _link(e, ctx, materials, warnings) for e in link_elems}
     joints = {e.get("name", ""): _joint(e, ctx) for e in joint_elems}
-    gazebo = parse_gazebo(root.findall("gazebo"), source)
+    gazebo = parse_gazebo(root.findall("gazebo"), source, model_name=name)
     model = RobotModel(
         name=name,
         links=links,
@@ -393,10 +393,15 @@ def _check_gazebo(model: RobotModel, ctx: _Ctx) -> None:
     for p in model.gazebo.plugins:
         where = f"<plugin name='{p.name}' filename='{p.filename}'>"
         if isinstance(p.spec, DiffDriveSpec):
-            for role, joint in (
-                ("leftJoint", p.spec.left_joint),
-                ("rightJoint", p.spec.right_joint),
-            ):
+            roles = [("leftJoint", p.spec.left_joint), ("rightJoint", p.spec.right_joint)]
+            if p.spec.rear_joints is not None:  # skid steer: Gazebo throws on a missing one
+                roles = [
+                    ("leftFrontJoint", p.spec.left_joint),
+                    ("rightFrontJoint", p.spec.right_joint),
+                    ("leftRearJoint", p.spec.rear_joints[0]),
+                    ("rightRearJoint", p.spec.rear_joints[1]),
+                ]
+            for role, joint in roles:
                 j = model.joints.get(joint)
                 if j is None or not j.movable:
                     raise ctx.fail(f"{where}: <{role}> '{joint}' is not a movable joint")

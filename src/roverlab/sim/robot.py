@@ -85,12 +85,13 @@ def _body_points(model: RobotModel, base: str) -> F64:
 
 def _wheel_acceleration(model: RobotModel, dd: DiffDriveSpec) -> float:
     """The wheels' surface acceleration limit: ``wheelAcceleration``, and what
-    ``wheelTorque`` can give the robot's mass (two wheels pushing: 2 T / (r m)); 0 means
-    unlimited, as the plugin's ``wheelAcceleration`` 0."""
+    ``wheelTorque`` (skid steer: ``torque``) can give the robot's mass (n wheels pushing:
+    n T / (r m)); 0 means unlimited, as the plugin's ``wheelAcceleration`` 0."""
     mass = sum(link.inertial.mass for link in model.links.values() if link.inertial is not None)
     limits = [dd.wheel_acceleration] if dd.wheel_acceleration > 0 else []
     if mass > 0 and dd.wheel_torque_nm > 0:
-        limits.append(2.0 * dd.wheel_torque_nm / (0.5 * dd.wheel_diameter_m * mass))
+        n = dd.wheel_count
+        limits.append(n * dd.wheel_torque_nm / (0.5 * dd.wheel_diameter_m * mass))
     return min(limits) if limits else 0.0
 
 
