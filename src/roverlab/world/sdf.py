@@ -5,8 +5,10 @@ What is read:
 * every ``<model>`` of the ``<world>`` (static or not, nested models too) and every
   ``<include><uri>model://NAME</uri>`` (its ``<name>`` and ``<pose>`` replace the included
   model's own), with ``<pose>`` of model, link and collision composed; ``<pose frame=...>``
-  (SDF 1.5/1.6) and ``relative_to`` (1.7) may name the world, the parent model or a
-  link of the same model;
+  (SDF 1.5/1.6) and ``relative_to`` (1.7) may name the world, the parent model, a link
+  of the same model or an SDF 1.7 ``<frame>`` (of the world, or of the model:
+  ``attached_to`` a link, a frame or the model); a nested model's or include's pose may
+  name its parent model's links and frames;
 * ``<collision>`` geometry: ``box``, ``cylinder``, ``sphere``, ``polyline`` (a closed,
   extruded outline), ``mesh`` (STL, Collada, OBJ from ``model://``, ``file://`` or a
   relative path, with ``<scale>``: each part's convex outline extruded over its z range,
@@ -150,6 +152,10 @@ def load_sdf(
     return loader.load(p)
 
 
+_Scope = tuple[Callable[[str], Transform3], dict[str, ET.Element]]
+"""Frames a pose can name (a resolver to world transforms, and the names it knows)."""
+
+
 @dataclass(eq=False)
 class _State:
     """Poses from a ``<state>`` section (world frame)."""
@@ -199,7 +205,9 @@ class _SdfLoader(SdfShapeReader):
             background = world.find("scene/background")
             if world.find("scene/sky") is None and background is not None:
                 sky = self._colour(doc, background, "world / <scene><background>") or sky
-            self._children(doc, world, _IDENTITY, states, "")
+            wframes = {f.get("name", ""): f for f in world.findall("frame")}
+            scope = self._frame_scope(doc, wframes, _IDENTITY, {}, "world", None)
+            self._children(doc, world, _IDENTITY, states, "", scope)
         return World(
             name=name,
             shapes=tuple(self.shapes),
@@ -221,14 +229,15 @@ class _SdfLoader(SdfShapeReader):
         parent_tf: Transform3,
         states: dict[str, _State],
         label: str,
+        scope: _Scope | None = None,
     ) -> None:
         for child in parent:
             tag = child.tag
             if tag == "model":
                 name = child.get("name", "")
-                self._model(doc, child, parent_tf, states.get(name), label, name=name)
+                self._model(doc, child, parent_tf, states.get(name), label, name=name, scope=scope)
             elif tag == "include":
-                self._include(doc, child, parent_tf, states, label)
+                self._include(doc, child, parent_tf, states, label, scope)
             elif tag == "actor":
                 self._warn(doc, child, f"actor {child.get('name', '')!r} skipped (actors move)")
             elif tag in ("population", "road", "road_network"):
@@ -272,6 +281,7 @@ class _SdfLoader(SdfShapeReader):
         parent_tf: Transform3,
         states: dict[str, _State],
         label: str,
+        scope: _Scope | None = None,
     ) -> None:
         uri_el = el.find("uri")
         uri = _text(uri_el)
@@ -306,7 +316,9 @@ class _SdfLoader(SdfShapeReader):
         override = None
         if el.find("pose") is not None:
             pose, frame = self._pose(doc, el, ilabel)
-            override = self._frame_base(doc, el, frame, parent_tf, {}, ilabel) * pose
+            override = (
+                self._frame_base(doc, el, frame, parent_tf, {}, ilabel, *(scope or ())) * pose
+            )
         self.include_stack.append(key)
         try:
             self._model(
@@ -378,6 +390,7 @@ class _SdfLoader(SdfShapeReader):
         *,
         name: str,
         world_pose: Transform3 | None = None,
+        scope: _Scope | None = None,
     ) -> None:
         mlabel = _join(label, f"model {name!r}")
         robot_signs = [t for t in ("sensor", "plugin") if next(el.iter(t), None) is not None]
@@ -394,7 +407,8 @@ class _SdfLoader(SdfShapeReader):
             model_tf = world_pose
         else:
             pose, frame = self._pose(doc, el, mlabel)
-            model_tf = self._frame_base(doc, el, frame, parent_tf, {}, mlabel) * pose
+            base = self._frame_base(doc, el, frame, parent_tf, {}, mlabel, *(scope or ()))
+            model_tf = base * pose
 
         links = {lk.get("name", ""): lk for lk in el.findall("link")}
         link_tfs: dict[str, Transform3] = {}
@@ -413,29 +427,62 @@ class _SdfLoader(SdfShapeReader):
             visiting.add(lname)
             pose, frame = self._pose(doc, lk, llabel)
             frames = {name: model_tf, "__model__": model_tf}
-            base = self._frame_base(doc, lk, frame, model_tf, frames, llabel, link_tf, links)
+            base = self._frame_base(doc, lk, frame, model_tf, frames, llabel, *inner)
             link_tfs[lname] = base * pose
             visiting.discard(lname)
             return link_tfs[lname]
 
+        model_frames = {name: model_tf, "__model__": model_tf}
+        frame_els = {f.get("name", ""): f for f in el.findall("frame")}
+        inner = self._frame_scope(doc, frame_els, model_tf, model_frames, mlabel, (link_tf, links))
         for lname, lk in links.items():
             self._link(
-                doc,
-                lk,
-                link_tf(lname),
-                model_tf,
-                name,
-                link_tf,
-                links,
-                _join(mlabel, f"link {lname!r}"),
-            )
+                doc, lk, link_tf(lname), model_tf, name, *inner, _join(mlabel, f"link {lname!r}")
+            )  # fmt: skip
         nested_states = state.models if state is not None else {}
         for child in el:
             if child.tag == "model":
                 cname = child.get("name", "")
-                self._model(doc, child, model_tf, nested_states.get(cname), mlabel, name=cname)
+                self._model(
+                    doc, child, model_tf, nested_states.get(cname), mlabel, name=cname, scope=inner
+                )
             elif child.tag == "include":
-                self._include(doc, child, model_tf, nested_states, mlabel)
+                self._include(doc, child, model_tf, nested_states, mlabel, inner)
+
+    def _frame_scope(
+        self,
+        doc: XmlDoc,
+        frame_els: dict[str, ET.Element],
+        default: Transform3,
+        frames: dict[str, Transform3],
+        label: str,
+        outer: _Scope | None,
+    ) -> _Scope:
+        """Names a pose may be ``relative_to``: SDF 1.7 ``<frame>`` elements (``attached_to``
+        a link, a frame or the model; the pose is relative to ``attached_to`` unless it
+        says otherwise), then ``outer``'s names (the model's links)."""
+        names: dict[str, ET.Element] = {**(outer[1] if outer else {}), **frame_els}
+        cache: dict[str, Transform3] = {}
+        visiting: set[str] = set()
+
+        def resolve(fname: str) -> Transform3:
+            if fname not in frame_els:
+                assert outer is not None  # only names in ``names`` are resolved
+                return outer[0](fname)
+            if fname not in cache:
+                f = frame_els[fname]
+                flabel = _join(label, f"frame {fname!r}")
+                if fname in visiting:
+                    raise WorldError(f"{doc.where(f)}: {flabel}: pose frames form a cycle")
+                visiting.add(fname)
+                pose, rel = self._pose(doc, f, flabel)
+                base_name = rel or f.get("attached_to") or None
+                base = self._frame_base(doc, f, base_name, default, frames, flabel, resolve, names)
+                cache[fname] = base * pose
+                visiting.discard(fname)
+            return cache[fname]
+
+        return (resolve, names)
 
     def _frame_base(
         self,
