@@ -197,6 +197,20 @@ def test_unknown_package_lists_search_path(tmp_path: Path) -> None:
     assert str(BUNDLED_PACKAGES_DIR) in msg
 
 
+def test_errors_inside_expressions_name_their_cause(tmp_path: Path) -> None:
+    # ${load_yaml('$(find x)/...')}: xacro wraps the error once per expression; the line
+    # names the cause as it does outside an expression, without xacro's class names
+    yaml = "${xacro.load_yaml('$(find ghost_pkg)/config/d.yaml')}"
+    msg = _error(tmp_path, f'<xacro:property name="d" value="{yaml}"/><link name="${{d}}"/>')
+    assert "$(find): package 'ghost_pkg' not found" in msg
+    assert "<class" not in msg and msg.count("not found") == 1
+    missing = f"${{load_yaml('{tmp_path}/absent.yaml')}}"
+    msg = _error(tmp_path, f'<xacro:property name="d" value="{missing}"/><link name="${{d}}"/>')
+    assert msg.endswith(f": cannot read {tmp_path}/absent.yaml: No such file or directory")
+    msg = _error(tmp_path, '<link name="${$(arg width) * 2}"/>')
+    assert "$(arg width): undefined xacro argument" in msg
+
+
 def test_undefined_arg(tmp_path: Path) -> None:
     msg = _error(tmp_path, '<link name="$(arg nope)"/>')
     assert "$(arg nope)" in msg and "nope:=value" in msg

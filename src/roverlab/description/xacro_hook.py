@@ -195,16 +195,34 @@ def _one_line(text: str) -> str:
     return " ".join(text.split())
 
 
+def _cause(err: BaseException) -> BaseException | None:
+    """What went wrong under xacro's wrapping: an expression (``${load_yaml('$(find x)/a')}``)
+    wraps the error once more for each enclosing expression, so follow ``exc`` (and the
+    exception chain) down to the first error that is not xacro's own."""
+    seen: set[int] = set()
+    cause: BaseException | None = getattr(err, "exc", None)
+    while cause is not None and id(cause) not in seen:
+        seen.add(id(cause))
+        if not isinstance(cause, xacro.XacroException):
+            return cause
+        cause = getattr(cause, "exc", None) or cause.__cause__ or cause.__context__
+    return None
+
+
 def _translate(err: Exception, label: str) -> XacroError:
     where = _where(label)
     context = _macros()
-    cause = getattr(err, "exc", None)
+    cause = _cause(err)
     if isinstance(cause, PackageNotFoundError):
         return XacroError(f"{where}: {context}$(find): {cause}")
     if isinstance(cause, OSError) and getattr(cause, "filename", None):
-        return XacroError(
-            f"{where}: {context}<xacro:include filename='{cause.filename}'>: "
-            f"{cause.strerror or 'cannot open'}"
+        if cause is getattr(err, "exc", None):  # xacro's include
+            return XacroError(
+                f"{where}: {context}<xacro:include filename='{cause.filename}'>: "
+                f"{cause.strerror or 'cannot open'}"
+            )
+        return XacroError(  # in an expression: load_yaml
+            f"{where}: {context}cannot read {cause.filename}: {cause.strerror or 'cannot open'}"
         )
     if isinstance(cause, xacro.substitution_args.ArgException):
         name = str(cause)
