@@ -216,12 +216,13 @@ def _translate(err: Exception, label: str) -> XacroError:
     if isinstance(cause, PackageNotFoundError):
         return XacroError(f"{where}: {context}$(find): {cause}")
     if isinstance(cause, OSError) and getattr(cause, "filename", None):
-        if cause is getattr(err, "exc", None):  # xacro's include
+        included = cause is getattr(err, "exc", None)  # xacro's include, not load_yaml
+        if included:
             return XacroError(
                 f"{where}: {context}<xacro:include filename='{cause.filename}'>: "
                 f"{cause.strerror or 'cannot open'}"
             )
-        return XacroError(  # in an expression: load_yaml
+        return XacroError(
             f"{where}: {context}cannot read {cause.filename}: {cause.strerror or 'cannot open'}"
         )
     if isinstance(cause, xacro.substitution_args.ArgException):
