@@ -199,7 +199,7 @@ def _run(
     wall = run_context(context, duration)
     sim_s = context.now().seconds
     typer.echo(
-        f"simulated {sim_s:.1f} s in {wall:.1f} s wall ({sim_s / max(wall, 1e-9):.1f}x real time)"
+        f"simulated {sim_s:.1f} s in {wall:.3g} s wall ({sim_s / max(wall, 1e-9):.1f}x real time)"
         + (f"; recorded {recorder.messages} messages to {record}" if recorder else ""),
         err=True,
     )
