@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
+import pytest
+
 from roverlab.description import format_check, format_tree, load_robot
 from tests.description.conftest import MYBOT_URDF, MYBOT_XACRO, robot
 
@@ -66,3 +70,65 @@ def test_check_marks_unsupported_plugins_and_unknown_references() -> None:
     assert "  s (sonar) on a: not supported by roverlab" in text
     assert "unsupported (ignored): plugin libgazebo_ros_control.so, sensor type sonar" in text
     assert "warning: <gazebo reference> names no link or joint: 'ghost'" in text
+
+
+CONTACT_ROBOT = robot(
+    '<link name="base"><collision><geometry><box size="0.3 0.2 0.1"/></geometry></collision>'
+    '</link><link name="wheel"/>'
+    '<joint name="j" type="continuous"><parent link="base"/><child link="wheel"/></joint>'
+    '<gazebo reference="wheel"><material>Gazebo/Black</material><mu1>0.2</mu1><mu2>0.2</mu2>'
+    "<kp>1e6</kp><turnGravityOff>true</turnGravityOff></gazebo>"
+    '<gazebo reference="base"><selfCollide>true</selfCollide></gazebo>'
+    "<gazebo><static>false</static></gazebo>",
+    "contact",
+)
+
+
+def test_gazebo_settings_the_simulator_does_not_act_on_are_named() -> None:
+    from roverlab.description.check import robot_notes
+
+    model = load_robot(CONTACT_ROBOT)
+    short = robot_notes(model)
+    assert len(short) == 2, short
+    assert short[0].endswith(
+        "settings not simulated (the drive is kinematic, a contact stops the body): "
+        "mu1, mu2, kp, turnGravityOff, selfCollide on 2 links"
+    ), short
+    assert "model settings not simulated: static" in short[1]
+    detail = robot_notes(model, detail=True)[0]
+    assert "mu1 (wheel); mu2 (wheel); kp (wheel); turnGravityOff (wheel); selfCollide (base)" in (
+        detail
+    )
+    assert "material" not in detail  # read: the dashboard's colour
+    report = format_check(model)
+    assert "note: " + detail in report.splitlines()
+    bare = robot(
+        '<link name="base"/><gazebo reference="base"><material>Gazebo/Red</material></gazebo>'
+    )
+    assert robot_notes(load_robot(bare)) == []
+
+
+def test_sim_prints_the_notes_and_strict_does_not_refuse_them(
+    tmp_path: Path, capfd: pytest.CaptureFixture[str]
+) -> None:
+    from tests.helpers.nodes import run_main
+
+    urdf = tmp_path / "contact.urdf"
+    urdf.write_text(CONTACT_ROBOT)
+    code = run_main(
+        [
+            "sim",
+            "--robot",
+            str(urdf),
+            "--world",
+            "empty",
+            "--rate",
+            "max",
+            "--duration",
+            "0.1",
+            "--strict",
+        ]
+    )
+    err = capfd.readouterr().err
+    assert code == 0, err
+    assert f"note: {urdf}: <gazebo reference> settings not simulated" in err, err

@@ -176,6 +176,13 @@ def report_warnings(title: str, lines: list[str], strict: bool) -> None:
         raise typer.Exit(2)
 
 
+def report_notes(lines: list[str]) -> None:
+    """Print what a file sets that roverlab reads and does not act on, ``note:`` a line
+    (not warnings: ``--strict`` does not refuse them)."""
+    for line in lines:
+        typer.echo(f"note: {line}", err=True)
+
+
 def network_options(ctx: typer.Context) -> NetworkOptions:
     """The root command's connection options (``roverlab --connect ... CMD``)."""
     obj = ctx.find_root().obj

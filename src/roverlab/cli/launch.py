@@ -8,7 +8,13 @@ from typing import Annotated
 
 import typer
 
-from roverlab.cli.common import StartGuard, expose_if_asked, report_warnings, run_context
+from roverlab.cli.common import (
+    StartGuard,
+    expose_if_asked,
+    report_notes,
+    report_warnings,
+    run_context,
+)
 from roverlab.cli.sim import parse_rate
 from roverlab.core import Context, configure_logging
 from roverlab.description import find_package
@@ -138,6 +144,7 @@ def launch(
         report_warnings(f"launch {path.name}", started.warnings, strict)
         report_warnings("Gazebo world", started.world_warnings, strict)
         report_warnings("spawned robot", started.robot_warnings, strict)
+        report_notes(started.robot_notes)
     names = ", ".join(n.get_fully_qualified_name() for n in started.nodes)
     typer.echo(f"started {len(started.nodes)} nodes: {names}", err=True)
     started.supervise()

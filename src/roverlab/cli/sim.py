@@ -12,12 +12,13 @@ import typer
 from roverlab.cli.common import (
     StartGuard,
     expose_if_asked,
+    report_notes,
     report_warnings,
     run_context,
     stop_on_signals,
 )
 from roverlab.core import Context, configure_logging
-from roverlab.description.check import robot_warnings
+from roverlab.description.check import robot_notes, robot_warnings
 from roverlab.sim.app import Simulation, SimulationError
 from roverlab.sim.node import SpawnPose
 from roverlab.world import world_warnings
@@ -176,6 +177,7 @@ def _run(
         report_warnings(
             f"robot {simulation.robot_model.name}", robot_warnings(simulation.robot_model), strict
         )
+        report_notes(robot_notes(simulation.robot_model))
         expose_if_asked(ctx, context, expose, pace)
     recorder = guard.recorder
     cfg = simulation.config

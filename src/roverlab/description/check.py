@@ -31,7 +31,22 @@ from roverlab.description.gazebo_specs import (
 from roverlab.description.meshes import mesh_points
 from roverlab.description.model import Mesh, RobotModel
 
-__all__ = ["format_check", "format_tree", "robot_warnings"]
+__all__ = ["format_check", "format_tree", "robot_notes", "robot_warnings"]
+
+# <gazebo reference> settings (URDF tag -> GazeboReference field) that the 2D simulator
+# reads nowhere: its drive is kinematic (wheel slip is the gazebo node's wheel_slip) and a
+# contact stops the body, so ODE's friction and contact parameters have nothing to act on.
+_CONTACT_SETTINGS = {
+    "mu1": "mu1",
+    "mu2": "mu2",
+    "kp": "kp",
+    "kd": "kd",
+    "minDepth": "min_depth",
+    "maxVel": "max_vel",
+    "fdir1": "fdir1",
+    "selfCollide": "self_collide",
+    "gravity": "gravity",
+}
 
 
 def robot_warnings(model: RobotModel) -> list[str]:
@@ -59,6 +74,37 @@ def robot_warnings(model: RobotModel) -> list[str]:
         out.append(
             f"{src}: <gazebo reference> names no link or joint (ignored): "
             + ", ".join(f"'{r}'" for r in unknown)
+        )
+    return out
+
+
+def robot_notes(model: RobotModel, *, detail: bool = False) -> list[str]:
+    """``<gazebo>`` settings of the robot that Gazebo's physics uses and the 2D simulator
+    does not, by name: ODE friction and contact parameters of the links (``mu1``, ``kp``,
+    ``selfCollide``...), other simple elements of a ``<gazebo reference>``, and the
+    model-level ones (``static``...). Only ``material`` (the dashboard's colour) is read
+    from a reference. Notes, not warnings: the bundled robots set them for Gazebo too, and
+    nothing the simulation does depends on them. ``detail`` names the links of each."""
+    src = model.source
+    settings: dict[str, list[str]] = {}
+    for name, ref in model.gazebo.references.items():
+        keys = [tag for tag, attr in _CONTACT_SETTINGS.items() if getattr(ref, attr) is not None]
+        for tag in [*keys, *ref.params]:
+            settings.setdefault(tag, []).append(name)
+    out: list[str] = []
+    if settings:
+        if detail:
+            listed = "; ".join(f"{tag} ({', '.join(links)})" for tag, links in settings.items())
+        else:
+            n = len({link for links in settings.values() for link in links})
+            listed = f"{', '.join(settings)} on {n} link{'s' if n != 1 else ''}"
+        out.append(
+            f"{src}: <gazebo reference> settings not simulated (the drive is kinematic, a "
+            f"contact stops the body): {listed}"
+        )
+    if model.gazebo.model_params:
+        out.append(
+            f"{src}: <gazebo> model settings not simulated: " + ", ".join(model.gazebo.model_params)
         )
     return out
 
@@ -221,4 +267,5 @@ def format_check(model: RobotModel) -> str:
             + ", ".join(f"'{r}'" for r in unknown)
         )
     lines.extend(f"warning: {w}" for w in [*model.warnings, *_shape_warnings(model)])
+    lines.extend(f"note: {n}" for n in robot_notes(model, detail=True))
     return "\n".join(lines)

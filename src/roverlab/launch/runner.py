@@ -13,7 +13,7 @@ from pathlib import Path
 
 from roverlab.core import Context, Node, QoSProfile
 from roverlab.core.log import log_to_file
-from roverlab.description.check import robot_warnings
+from roverlab.description.check import robot_notes, robot_warnings
 from roverlab.launch.registry import REGISTRY, LaunchState
 from roverlab.launch.xml import LaunchError, LaunchSpec, NodeSpec, load_launch
 from roverlab.msgs import classes as mc
@@ -146,6 +146,8 @@ class Launch:
     """The Gazebo world's warnings, grouped (models and meshes not found, ...)."""
     robot_warnings: list[str] = field(default_factory=list)
     """The spawned robot's warnings (urdfdom's, unsupported plugins and sensors)."""
+    robot_notes: list[str] = field(default_factory=list)
+    """The spawned robot's Gazebo settings that the simulator does not act on."""
 
 
 def build_launch(
@@ -179,6 +181,7 @@ def build_launch(
             raise LaunchError(f"{state.spawns[1][2]}: one robot per simulation is supported")
         robot, (x, y, yaw), _ = state.spawns[0]
         launch.robot_warnings = robot_warnings(robot)
+        launch.robot_notes = robot_notes(robot)
         launch.simulator = SimulatorNode(
             context=context,
             scene=state.world.to_scene(),
