@@ -166,7 +166,7 @@ def build_launch(
         LaunchError: a malformed file, a missing file or package, a bad node argument.
     """
     spec = path if isinstance(path, LaunchSpec) else load_launch(path, args)
-    state = LaunchState(context=context, params=spec.params)
+    state = LaunchState(context=context, params=spec.params, warnings=list(spec.warnings))
     launch = Launch(context=context, spec=spec, state=state)
     for node_spec in spec.nodes:
         launch.start_node(node_spec)
