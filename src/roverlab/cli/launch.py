@@ -18,7 +18,8 @@ from roverlab.cli.common import (
 from roverlab.cli.sim import parse_rate
 from roverlab.core import Context, configure_logging
 from roverlab.description import find_package
-from roverlab.launch import LaunchError, LaunchSpec, build_launch, load_launch
+from roverlab.launch import REGISTRY, LaunchError, LaunchSpec, build_launch, load_launch
+from roverlab.launch.process import find_script
 
 CLOCKS = ("auto", "sim", "external", "wall")
 _SIMULATOR_NODES = {("gazebo_ros", "gzserver"), ("gazebo_ros", "spawn_model")}
@@ -138,8 +139,12 @@ def launch(
     with guard:
         if record is not None:
             guard.record(record)
-        started = build_launch(spec, context=context, seed=seed)
+        # the topics are exposed first: script nodes run in processes of their own
+        scripts = [n for n in spec.nodes if (n.pkg, n.type) not in REGISTRY and find_script(n)]
+        if scripts and expose is None:
+            expose = True  # --rate max too: the scripts must hear the launch
         expose_if_asked(ctx, context, expose, pace)
+        started = build_launch(spec, context=context, seed=seed)
     with guard:
         report_warnings(f"launch {path.name}", started.warnings, strict)
         report_warnings("Gazebo world", started.world_warnings, strict)
@@ -147,8 +152,9 @@ def launch(
         report_notes(started.robot_notes)
     names = ", ".join(n.get_fully_qualified_name() for n in started.nodes)
     typer.echo(f"started {len(started.nodes)} nodes: {names}", err=True)
+    for name, (_, proc) in started.processes.items():
+        typer.echo(f"started process [{name}] (pid {proc.pid}): {proc.script}", err=True)
     started.supervise()
     wall = run_context(context, duration)
-    typer.echo(
-        f"launch stopped after {context.now().seconds:.1f} sim s ({wall:.1f} s wall)", err=True
-    )
+    ran = "" if mode == "wall" else f"{context.now().seconds:.1f} sim s, "
+    typer.echo(f"launch stopped after {ran}{wall:.1f} s wall", err=True)

@@ -12,8 +12,11 @@ from functools import partial
 from pathlib import Path
 
 from roverlab.core import Context, Node, QoSProfile
+from roverlab.core.executor import ClockMode
 from roverlab.core.log import log_to_file
+from roverlab.core.transport.zenoh import ZenohTransport
 from roverlab.description.check import robot_notes, robot_warnings
+from roverlab.launch.process import ScriptProcess, ScriptProcesses, find_script, is_python_script
 from roverlab.launch.registry import REGISTRY, LaunchState
 from roverlab.launch.xml import LaunchError, LaunchSpec, NodeSpec, load_launch
 from roverlab.msgs import classes as mc
@@ -53,6 +56,9 @@ class Launch:
     # what roslaunch does for a process: which node runs each <node>, and how it ended
     running: dict[str, tuple[NodeSpec, Node]] = field(default_factory=dict)
     deaths: list[str] = field(default_factory=list)
+    # the user's own scripts, each in a process of its own (roverlab run), by node name
+    processes: dict[str, tuple[NodeSpec, ScriptProcess]] = field(default_factory=dict)
+    _group: ScriptProcesses | None = None
     _watch: threading.Thread | None = None
 
     def start_node(self, node_spec: NodeSpec) -> Node | None:
@@ -62,11 +68,13 @@ class Launch:
         assert self.state is not None
         factory = REGISTRY.get((node_spec.pkg, node_spec.type))
         if factory is None:
-            self.state.warnings.append(
-                f"{node_spec.source}: node {node_spec.pkg}/{node_spec.type} is not part of "
-                "roverlab; skipped"
-            )
+            self.start_script(node_spec)
             return None
+        if node_spec.launch_prefix:
+            self.state.warnings.append(
+                f"{node_spec.source}: launch-prefix={node_spec.launch_prefix!r} not applied: "
+                f"roverlab's {node_spec.pkg}/{node_spec.type} runs in the launch's process"
+            )
         before = set(self.context.nodes)
         try:
             with _environment(node_spec.env):
@@ -94,10 +102,42 @@ class Launch:
         self.running[node_spec.fq_name] = (node_spec, node)
         return node
 
+    def start_script(self, node_spec: NodeSpec) -> None:
+        """A ``<node>`` roverlab does not implement: the package's Python script in a
+        process of its own (as ``roverlab run``), else skipped with a warning."""
+        assert self.state is not None
+        what = f"{node_spec.source}: node {node_spec.pkg}/{node_spec.type}"
+        script = find_script(node_spec)
+        if script is None:
+            self.state.warnings.append(
+                f"{what} is not part of roverlab and package {node_spec.pkg} has no "
+                f"script {node_spec.type!r}; skipped"
+            )
+            return
+        if not is_python_script(script):
+            self.state.warnings.append(
+                f"{what}: {script} is not a Python script (roverlab runs rospy scripts, "
+                "not compiled nodes); skipped"
+            )
+            return
+        if not any(isinstance(t, ZenohTransport) for t in self.context.transports):
+            raise LaunchError(
+                f"{what}: the script runs in a process of its own, which needs the launch's "
+                "topics exposed (--expose)"
+            )
+        if self._group is None:
+            self._group = ScriptProcesses()
+            self.context.add_transport(self._group)  # stopped when the context shuts down
+        clock = "wall" if self.context.clock_mode is ClockMode.WALL else "external"
+        proc = ScriptProcess(node_spec, script, clock=clock, params=self.spec.params)
+        self._group.processes.append(proc)
+        self.processes[node_spec.fq_name] = (node_spec, proc)
+
     def died(self, node_spec: NodeSpec, reason: str) -> None:
         """roslaunch's handling of a process that ended: respawn, shut down, or report."""
         name = node_spec.fq_name
         self.running.pop(name, None)
+        self.processes.pop(name, None)
         if node_spec.required:
             self.deaths.append(f"REQUIRED process [{name}] has died: {reason}; shutting down")
             print(f"[ERROR] {self.deaths[-1]}", file=sys.stderr, flush=True)
@@ -134,6 +174,12 @@ class Launch:
                     node_spec, node = spec_node
                     if node.is_destroyed() and node_spec.fq_name in self.running:
                         self.context.executor.call_soon_threadsafe(partial(self._ended, node_spec))
+                for node_spec, proc in list(self.processes.values()):
+                    code = proc.poll()
+                    if code is not None:
+                        self.context.executor.call_soon_threadsafe(
+                            partial(self._exited, node_spec, proc, code)
+                        )
 
         self._watch = threading.Thread(target=watch, name="roslaunch-watch", daemon=True)
         self._watch.start()
@@ -141,6 +187,17 @@ class Launch:
     def _ended(self, node_spec: NodeSpec) -> None:
         if node_spec.fq_name in self.running and not self.context.is_shutdown():
             self.died(node_spec, "it ended")
+
+    def _exited(self, node_spec: NodeSpec, proc: ScriptProcess, code: int) -> None:
+        name = node_spec.fq_name
+        if self.processes.get(name, (None, None))[1] is not proc or self.context.is_shutdown():
+            return
+        proc.stop()  # its files
+        if code == 0 and not (node_spec.required or node_spec.respawn):
+            self.processes.pop(name)
+            print(f"[INFO] process [{name}] has finished cleanly", file=sys.stderr, flush=True)
+            return
+        self.died(node_spec, f"pid {proc.pid}, exit code {code}")
 
     world_warnings: list[str] = field(default_factory=list)
     """The Gazebo world's warnings, grouped (models and meshes not found, ...)."""
@@ -168,7 +225,7 @@ def build_launch(
         LaunchError: a malformed file, a missing file or package, a bad node argument.
     """
     spec = path if isinstance(path, LaunchSpec) else load_launch(path, args)
-    state = LaunchState(context=context, params=spec.params)
+    state = LaunchState(context=context, params=spec.params, warnings=list(spec.warnings))
     launch = Launch(context=context, spec=spec, state=state)
     for node_spec in spec.nodes:
         launch.start_node(node_spec)

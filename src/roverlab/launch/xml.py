@@ -8,7 +8,9 @@ ns, output, respawn, required, and its ``<param>``/``<rosparam>``/``<remap>`` ch
 ``<remap>``, ``<env>``, ``if=``/``unless=`` on every element, and the substitutions
 ``$(find pkg)``, ``$(arg name)``, ``$(env VAR)``, ``$(optenv VAR default)``,
 ``$(anon name)``, ``$(dirname)`` and ``$(eval expr)``. ``<machine>``, ``<test>`` and
-``<master>`` are ignored. Every error names the file and the element.
+``<master>`` are read (roverlab runs every node here and needs no master; a ``<test>``
+and a remote machine are reported), and so is an attribute roslaunch does not know, in
+:attr:`LaunchSpec.warnings`. Every error names the file and the element.
 """
 
 from __future__ import annotations
@@ -16,63 +18,47 @@ from __future__ import annotations
 import math
 import os
 import re
-import shlex
-import subprocess
+import socket
 import xml.etree.ElementTree as ET
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import yaml
 
-from roverlab.description import find_package, robot_description
+from roverlab.description import find_package
 from roverlab.description.errors import DescriptionError
-from roverlab.errors import RoverlabError
+from roverlab.launch.commands import command_value, xacro_argv
+from roverlab.launch.errors import LaunchError
+from roverlab.launch.spec import LaunchSpec, NodeSpec
 
 __all__ = ["LaunchError", "LaunchSpec", "NodeSpec", "load_launch"]
-
-
-class LaunchError(RoverlabError):
-    """A launch file could not be read or run."""
-
-
-@dataclass
-class NodeSpec:
-    """One ``<node>``: what to run, with its private parameters and remappings."""
-
-    pkg: str
-    type: str
-    name: str
-    namespace: str = "/"
-    args: str = ""
-    params: dict[str, Any] = field(default_factory=dict)
-    remaps: dict[str, str] = field(default_factory=dict)
-    source: str = ""
-    output: str = "log"  # roslaunch's default: INFO to the node's log file, WARN+ to screen
-    respawn: bool = False
-    respawn_delay: float = 0.0  # wall seconds
-    required: bool = False
-    env: dict[str, str] = field(default_factory=dict)  # <env> of its scope
-    clear_params: bool = False
-
-    @property
-    def fq_name(self) -> str:
-        return self.namespace.rstrip("/") + "/" + self.name
-
-
-@dataclass
-class LaunchSpec:
-    """Everything a launch file (with its includes) asks for."""
-
-    nodes: list[NodeSpec] = field(default_factory=list)
-    params: dict[str, Any] = field(default_factory=dict)  # global (absolute) names
-    files: list[Path] = field(default_factory=list)
 
 
 _SUBST = re.compile(r"\$\((\w+)((?:\s+[^()]*)?)\)")
 _TRUE = {"true", "1"}
 _FALSE = {"false", "0"}
+# roslaunch's $(eval) builtins (the math module's names are there too)
+_EVAL_BUILTINS = {"list": list, "dict": dict, "map": map, "str": str, "float": float, "int": int}
+# the attributes roslaunch knows on each element (if/unless on every one)
+_ATTRS = {
+    "launch": {"deprecated"},
+    "arg": {"name", "value", "default", "doc"},
+    "param": {"name", "value", "type", "textfile", "binfile", "command"},
+    "rosparam": {"command", "ns", "file", "param", "subst_value"},
+    "node": {"pkg", "type", "machine", "name", "args", "output", "respawn", "respawn_delay",
+             "cwd", "ns", "clear_params", "launch-prefix", "required"},
+    "include": {"file", "ns", "clear_params", "pass_all_args"},
+    "group": {"ns", "clear_params"},
+    "remap": {"from", "to"},
+    "env": {"name", "value"},
+    "machine": {"name", "address", "env-loader", "ssh-port", "user", "password", "default",
+                "timeout"},
+    "test": {"pkg", "type", "machine", "name", "args", "cwd", "ns", "clear_params",
+             "launch-prefix", "required", "test-name", "time-limit", "retry"},
+    "master": {"auto"},
+}  # fmt: skip
+_LOCAL_HOSTS = {"localhost", "127.0.0.1", "::1"}
 
 
 class _Scope:
@@ -92,6 +78,8 @@ class _Scope:
         self.remaps = remaps
         self.env = dict(env or {})  # <env> of this scope: for the nodes declared after it
         self.anon: dict[str, str] = {}
+        self.private: dict[str, Any] = {}  # <param name="~x">: for the nodes declared after it
+        self.declared: set[str] = set()  # the <arg> names this file declared
 
 
 def _where(scope: _Scope, elem: ET.Element) -> str:
@@ -150,7 +138,12 @@ class _Reader:
         return out
 
     def _eval(self, expr: str, scope: _Scope, elem: ET.Element) -> str:
+        if "__" in expr:
+            raise LaunchError(
+                f"{_where(scope, elem)}: $(eval) may not contain double underscore expressions"
+            )
         env: dict[str, Any] = {
+            **{k: v for k, v in vars(math).items() if not k.startswith("_")},
             "true": True,
             "false": False,
             "True": True,
@@ -164,7 +157,7 @@ class _Reader:
         }
         env.update({k: _typed(v) for k, v in scope.args.items() if k.isidentifier()})
         try:
-            value = eval(expr, {"__builtins__": {}, "math": math}, env)
+            value = eval(expr, {"__builtins__": _EVAL_BUILTINS, "math": math}, env)
         except Exception as err:
             raise LaunchError(f"{_where(scope, elem)}: $(eval {expr}) failed: {err}") from err
         return str(value).lower() if isinstance(value, bool) else str(value)
@@ -178,6 +171,8 @@ class _Reader:
         return self.subst(raw, scope, elem)
 
     def enabled(self, elem: ET.Element, scope: _Scope) -> bool:
+        if "if" in elem.attrib and "unless" in elem.attrib:
+            raise LaunchError(f"{_where(scope, elem)}: cannot set both 'if' and 'unless'")
         for key, want in (("if", True), ("unless", False)):
             if key in elem.attrib:
                 value = self.attr(elem, key, scope).strip().lower()
@@ -197,7 +192,8 @@ class _Reader:
         ns: str = "/",
         remaps: dict[str, str] | None = None,
         env: dict[str, str] | None = None,
-    ) -> None:
+        private: dict[str, Any] | None = None,
+    ) -> _Scope:
         self.spec.files.append(path)
         try:
             root = ET.parse(path).getroot()
@@ -208,7 +204,41 @@ class _Reader:
         if root.tag != "launch":
             raise LaunchError(f"{path}: the root element must be <launch>, not <{root.tag}>")
         scope = _Scope(path, dict(args), ns, dict(remaps or {}), env)
+        scope.private = dict(private or {})
+        self.check_attrs(root, scope)
+        if root.get("deprecated"):
+            self.warn(scope, root, f"deprecated: {self.attr(root, 'deprecated', scope)}")
         self.children(root, scope, passed=set(args))
+        return scope
+
+    def warn(self, scope: _Scope, elem: ET.Element, message: str) -> None:
+        self.spec.warnings.append(f"{_where(scope, elem)}: {message}")
+
+    def check_attrs(self, elem: ET.Element, scope: _Scope) -> None:
+        """roslaunch's warning for an attribute it does not know (a typo, mostly)."""
+        for name in sorted(set(elem.attrib) - _ATTRS.get(str(elem.tag), set()) - {"if", "unless"}):
+            self.warn(scope, elem, f"unknown attribute '{name}' (roslaunch ignores it too)")
+
+    def flag(self, elem: ET.Element, name: str, scope: _Scope) -> bool:
+        """A true/false attribute (false when absent)."""
+        text = self.attr(elem, name, scope, "false").strip().lower()
+        if text not in ("true", "false"):
+            raise LaunchError(f"{_where(scope, elem)}: {name} must be true or false, not {text!r}")
+        return text == "true"
+
+    def child_ns(self, elem: ET.Element, scope: _Scope) -> str:
+        """The namespace an element's ``ns=`` (and ``clear_params=``) makes."""
+        if "ns" not in elem.attrib:
+            if self.flag(elem, "clear_params", scope) and elem.tag != "node":
+                raise LaunchError(f"{_where(scope, elem)}: clear_params needs an ns attribute")
+            return scope.ns
+        ns = self.attr(elem, "ns", scope)
+        if not ns:
+            raise LaunchError(f"{_where(scope, elem)}: empty ns attribute")
+        # clear_params: roslaunch empties the namespace before this launch sets its
+        # parameters; roverlab keeps none between launches, so it holds already
+        self.flag(elem, "clear_params", scope)
+        return _join(scope.ns, ns) or "/"
 
     def children(self, parent: ET.Element, scope: _Scope, passed: set[str]) -> None:
         for elem in parent:
@@ -217,25 +247,33 @@ class _Reader:
             handler = self._handlers().get(elem.tag)
             if handler is None:
                 raise LaunchError(f"{_where(scope, elem)}: unknown launch element")
+            self.check_attrs(elem, scope)
             handler(elem, scope, passed)
 
     def _handlers(self) -> dict[str, Callable[[ET.Element, _Scope, set[str]], None]]:
         return {
             "arg": self.on_arg,
-            "param": lambda e, s, p: self.on_param(e, s, self.spec.params, s.ns),
-            "rosparam": lambda e, s, p: self.on_rosparam(e, s, self.spec.params, s.ns),
+            "param": lambda e, s, p: self.on_param(e, s, None),
+            "rosparam": lambda e, s, p: self.on_rosparam(e, s, None),
             "node": self.on_node,
             "include": self.on_include,
             "group": self.on_group,
             "remap": self.on_remap,
             "env": self.on_env,
-            "machine": lambda e, s, p: None,
-            "test": lambda e, s, p: None,
+            "machine": self.on_machine,
+            "test": lambda e, s, p: self.warn(
+                s, e, f"test '{e.get('test-name', '')}' not run: roslaunch leaves tests to rostest"
+            ),
+            # <master auto="start">: roslaunch starts a master when none runs; roverlab's
+            # nodes need none (they meet through the daemon), so it holds already
             "master": lambda e, s, p: None,
         }
 
     def on_arg(self, elem: ET.Element, scope: _Scope, passed: set[str]) -> None:
         name = self.attr(elem, "name", scope)
+        if name in scope.declared:
+            raise LaunchError(f"{_where(scope, elem)}: arg '{name}' has already been declared")
+        scope.declared.add(name)
         if "value" in elem.attrib and "default" in elem.attrib:
             raise LaunchError(f"{_where(scope, elem)}: arg '{name}' has both value and default")
         if "value" in elem.attrib:
@@ -247,59 +285,103 @@ class _Reader:
         elif name not in scope.args and "default" in elem.attrib:
             scope.args[name] = self.attr(elem, "default", scope)
 
-    def on_param(self, elem: ET.Element, scope: _Scope, into: dict[str, Any], ns: str) -> None:
-        name = self.attr(elem, "name", scope)
-        if "value" in elem.attrib:
-            value: Any = _typed(self.attr(elem, "value", scope), elem.get("type"))
-        elif "command" in elem.attrib:
-            value = self._command(self.attr(elem, "command", scope), scope, elem)
-        elif "textfile" in elem.attrib:
-            value = self._read_text(Path(self.attr(elem, "textfile", scope)), scope, elem)
-        elif "binfile" in elem.attrib:
-            value = Path(self.attr(elem, "binfile", scope)).read_bytes()
+    def put(self, scope: _Scope, name: str, value: Any, node: NodeSpec | None) -> None:
+        """Set a parameter as roslaunch does: ``~name`` is private (to the ``node``, or to
+        every node declared after it in this scope), ``/name`` global, else in the scope's
+        namespace (a node's private one inside ``<node>``)."""
+        if name.startswith("/"):
+            self.spec.params[name.rstrip("/")] = value
+        elif node is not None:
+            node.params[name.lstrip("~").strip("/")] = value
+        elif name.startswith("~"):
+            scope.private[name[1:].strip("/")] = value
         else:
-            raise LaunchError(f"{_where(scope, elem)}: param '{name}' has no value")
-        into[_join(ns, name)] = value
+            self.spec.params[_join(scope.ns, name.rstrip("/"))] = value
 
-    def on_rosparam(self, elem: ET.Element, scope: _Scope, into: dict[str, Any], ns: str) -> None:
+    def on_param(self, elem: ET.Element, scope: _Scope, node: NodeSpec | None) -> None:
+        name = self.attr(elem, "name", scope).strip()
+        sources = [k for k in ("value", "textfile", "binfile", "command") if k in elem.attrib]
+        if len(sources) != 1:
+            raise LaunchError(
+                f"{_where(scope, elem)}: param '{name}' needs one and only one of "
+                "value/textfile/binfile/command"
+            )
+        where = _where(scope, elem)
+        text = self.attr(elem, sources[0], scope)
+        value: Any
+        if sources[0] == "value":
+            try:
+                value = _typed(text, elem.get("type"))
+            except LaunchError as err:
+                raise LaunchError(f"{where}: {err}") from err
+        elif sources[0] == "command":
+            value = command_value(text, where, self.package_path)
+        elif sources[0] == "textfile":
+            value = self._read_text(Path(text), scope, elem)
+        else:
+            try:
+                value = Path(text).read_bytes()
+            except OSError as err:
+                raise LaunchError(f"{where}: cannot read {text}: {err.strerror}") from err
+        self.put(scope, name, value, node)
+
+    def on_rosparam(self, elem: ET.Element, scope: _Scope, node: NodeSpec | None) -> None:
+        where = _where(scope, elem)
         command = self.attr(elem, "command", scope, "load")
-        sub_ns = _join(ns, self.attr(elem, "ns", scope, "")) if elem.get("ns") else ns
+        param = _rel(self.attr(elem, "ns", scope, ""), self.attr(elem, "param", scope, ""))
+        if command not in ("load", "dump", "delete"):
+            raise LaunchError(f"{where}: rosparam command {command!r} unknown (load/dump/delete)")
         if command == "delete":
+            # roslaunch deletes before it sets this launch's parameters; roverlab keeps
+            # none between launches, so what it deletes is never there
+            if "file" in elem.attrib:
+                raise LaunchError(f"{where}: rosparam delete takes no file")
             return
         if command == "dump":
+            self.warn(
+                scope,
+                elem,
+                "rosparam dump not done: roslaunch dumps the parameter server before this "
+                "launch sets its parameters, and roverlab keeps none between launches "
+                "(`roverlab param dump` reads a running node's)",
+            )
             return
-        if command != "load":
-            raise LaunchError(f"{_where(scope, elem)}: rosparam command {command!r} unknown")
         if "file" in elem.attrib:
             text = self._read_text(Path(self.attr(elem, "file", scope)), scope, elem)
         else:
-            text = self.subst(elem.text or "", scope, elem)
+            text = "".join(elem.itertext())
+        if self.flag(elem, "subst_value", scope):
+            text = self.subst(text, scope, elem)
         try:
             data = yaml.safe_load(text) if text.strip() else None
         except yaml.YAMLError as err:
-            raise LaunchError(f"{_where(scope, elem)}: malformed YAML: {err}") from err
+            raise LaunchError(f"{where}: malformed YAML: {' '.join(str(err).split())}") from err
         if data is None:
             return
-        param = elem.get("param")
-        if param:
-            into[_join(sub_ns, self.subst(param, scope, elem))] = data
-            return
         if not isinstance(data, dict):
-            raise LaunchError(f"{_where(scope, elem)}: rosparam YAML must be a mapping")
+            if not param:
+                raise LaunchError(f"{where}: a rosparam value that is not a mapping needs param=")
+            self.put(scope, param, data, node)
+            return
+        if not param and node is None and scope.ns == "/" and not data:
+            return
         for key, value in _flatten(data).items():
-            into[_join(sub_ns, key)] = value
+            self.put(scope, _rel(param, key), value, node)
 
     def on_node(self, elem: ET.Element, scope: _Scope, passed: set[str]) -> None:
         pkg = self.attr(elem, "pkg", scope)
         typ = self.attr(elem, "type", scope)
-        name = self.attr(elem, "name", scope, typ.removesuffix(".py"))
-        ns = _join(scope.ns, self.attr(elem, "ns", scope, "")) if elem.get("ns") else scope.ns
+        name = self.attr(elem, "name", scope)
+        if not name or "/" in name or "~" in name:
+            raise LaunchError(f"{_where(scope, elem)}: illegal node name {name!r}")
+        ns = self.child_ns(elem, scope)
         node = NodeSpec(
             pkg=pkg,
             type=typ,
             name=name,
             namespace=ns or "/",
             args=self.attr(elem, "args", scope, ""),
+            params=dict(scope.private),
             remaps=dict(scope.remaps),
             source=_where(scope, elem),
             env=dict(scope.env),
@@ -308,40 +390,38 @@ class _Reader:
         for child in elem:
             if not isinstance(child.tag, str) or not self.enabled(child, scope):
                 continue
+            if child.tag not in ("param", "rosparam", "remap", "env"):
+                raise LaunchError(f"{_where(scope, child)}: not allowed inside <node>")
+            self.check_attrs(child, scope)
             if child.tag == "param":
-                self.on_param(child, scope, node.params, "")
+                self.on_param(child, scope, node)
             elif child.tag == "rosparam":
-                self.on_rosparam(child, scope, node.params, "")
+                self.on_rosparam(child, scope, node)
             elif child.tag == "remap":
                 node.remaps[self.attr(child, "from", scope)] = self.attr(child, "to", scope)
-            elif child.tag == "env":
-                self.env_into(child, scope, node.env)
             else:
-                raise LaunchError(f"{_where(scope, child)}: not allowed inside <node>")
-        node.params = {k.lstrip("/"): v for k, v in node.params.items()}
+                self.env_into(child, scope, node.env)
         # clear_params="true": roslaunch empties the node's private namespace on the
         # parameter server before it sets this launch's parameters. roverlab keeps no
         # parameters between launches, so a node's private parameters are always this
         # launch's only: the attribute is checked and holds already.
-        clear = self.attr(elem, "clear_params", scope, "false").lower()
-        if clear not in ("true", "false", "1", "0"):
-            raise LaunchError(f"{_where(scope, elem)}: clear_params must be true or false")
-        node.clear_params = clear in ("true", "1")
+        node.clear_params = self.flag(elem, "clear_params", scope)
+        if elem.get("machine"):
+            self.warn(
+                scope,
+                elem,
+                f"machine={self.attr(elem, 'machine', scope)!r}: the node runs on this machine",
+            )
         self.spec.nodes.append(node)
 
     def on_process_attrs(self, elem: ET.Element, scope: _Scope, node: NodeSpec) -> None:
-        """roslaunch's process attributes: output, respawn, respawn_delay, required."""
+        """roslaunch's process attributes: output, respawn, respawn_delay, required, cwd,
+        launch-prefix."""
         where = _where(scope, elem)
         node.output = self.attr(elem, "output", scope, "log")
         if node.output not in ("log", "screen"):
             raise LaunchError(f"{where}: output must be 'log' or 'screen', not {node.output!r}")
-        flags = {}
-        for name in ("respawn", "required"):
-            text = self.attr(elem, name, scope, "false").strip().lower()
-            if text not in ("true", "false"):
-                raise LaunchError(f"{where}: {name} must be true or false, not {text!r}")
-            flags[name] = text == "true"
-        node.respawn, node.required = flags["respawn"], flags["required"]
+        node.respawn, node.required = (self.flag(elem, k, scope) for k in ("respawn", "required"))
         if node.respawn and node.required:
             raise LaunchError(f"{where}: respawn and required cannot both be true")
         delay = self.attr(elem, "respawn_delay", scope, "0")
@@ -351,38 +431,65 @@ class _Reader:
             raise LaunchError(f"{where}: respawn_delay must be a number, not {delay!r}") from None
         if not (node.respawn_delay >= 0.0 and node.respawn_delay < float("inf")):
             raise LaunchError(f"{where}: respawn_delay must be >= 0 seconds, not {delay}")
+        node.cwd = self.attr(elem, "cwd", scope, "ROS_HOME")
+        if node.cwd not in ("ROS_HOME", "node"):
+            raise LaunchError(f"{where}: cwd must be 'ROS_HOME' or 'node', not {node.cwd!r}")
+        node.launch_prefix = self.attr(elem, "launch-prefix", scope, "")
 
     def on_include(self, elem: ET.Element, scope: _Scope, passed: set[str]) -> None:
         path = Path(self.attr(elem, "file", scope))
         if not path.is_absolute():
             path = scope.path.parent / path
-        ns = _join(scope.ns, self.attr(elem, "ns", scope, "")) if elem.get("ns") else scope.ns
+        ns = self.child_ns(elem, scope)
         args: dict[str, str] = {}
         env = dict(scope.env)
         for child in elem:
             if not isinstance(child.tag, str) or not self.enabled(child, scope):
                 continue
+            self.check_attrs(child, scope)
             if child.tag == "arg":
                 name = self.attr(child, "name", scope)
                 if "value" in child.attrib:
                     args[name] = self.attr(child, "value", scope)
                 elif "default" in child.attrib:
                     args[name] = self.attr(child, "default", scope)
+                else:
+                    raise LaunchError(f"{_where(scope, child)}: include args need a value")
             elif child.tag == "env":
                 self.env_into(child, scope, env)
             else:
                 raise LaunchError(f"{_where(scope, child)}: not allowed inside <include>")
-        if elem.get("pass_all_args", "false").lower() == "true":
+        pass_all = self.flag(elem, "pass_all_args", scope)
+        if pass_all:
             args = {**scope.args, **args}
         if not path.is_file():
             raise LaunchError(f"{_where(scope, elem)}: included file {path} does not exist")
-        self.read_file(path, args, ns or "/", scope.remaps, env)
+        inner = self.read_file(path, args, ns or "/", scope.remaps, env, scope.private)
+        unused = sorted(set(args) - inner.declared)
+        if unused and not pass_all:
+            raise LaunchError(
+                f"{_where(scope, elem)}: unused args [{', '.join(unused)}] for include of {path}"
+            )
 
     def on_group(self, elem: ET.Element, scope: _Scope, passed: set[str]) -> None:
-        ns = _join(scope.ns, self.attr(elem, "ns", scope, "")) if elem.get("ns") else scope.ns
+        ns = self.child_ns(elem, scope)
         inner = _Scope(scope.path, scope.args, ns or "/", dict(scope.remaps), scope.env)
         inner.anon = scope.anon
+        inner.declared = scope.declared  # the same file: one set of <arg> names
+        inner.private = dict(scope.private)
         self.children(elem, inner, passed)
+
+    def on_machine(self, elem: ET.Element, scope: _Scope, passed: set[str]) -> None:
+        """``<machine>``: nodes on another computer (over ssh) in roslaunch; roverlab runs
+        every node on this one, and says so for a machine that is not this one."""
+        name = self.attr(elem, "name", scope)
+        address = self.attr(elem, "address", scope)
+        if address not in _LOCAL_HOSTS and address != socket.gethostname():
+            self.warn(
+                scope,
+                elem,
+                f"machine '{name}' ({address}): roverlab starts every node on this machine",
+            )
 
     def on_remap(self, elem: ET.Element, scope: _Scope, passed: set[str]) -> None:
         scope.remaps[self.attr(elem, "from", scope)] = self.attr(elem, "to", scope)
@@ -402,77 +509,19 @@ class _Reader:
         except OSError as err:
             raise LaunchError(f"{_where(scope, elem)}: cannot read {path}: {err.strerror}") from err
 
-    def _command(self, command: str, scope: _Scope, elem: ET.Element) -> str:
-        """``command=``: xacro runs in-process (roverlab's hooked xacro); others in a shell."""
-        try:
-            argv = shlex.split(command)
-        except ValueError as err:
-            raise LaunchError(f"{_where(scope, elem)}: cannot parse command: {err}") from err
-        xacro_argv = _xacro_argv(argv)
-        if xacro_argv is not None:
-            return self._xacro(xacro_argv, scope, elem)
-        try:
-            done = subprocess.run(command, shell=True, capture_output=True, text=True, check=False)
-        except OSError as err:
-            raise LaunchError(f"{_where(scope, elem)}: command failed: {err}") from err
-        if done.returncode != 0:
-            first = (done.stderr.strip().splitlines() or ["no output"])[0]
-            raise LaunchError(f"{_where(scope, elem)}: command exited {done.returncode}: {first}")
-        return done.stdout
-
-    def _xacro(self, argv: list[str], scope: _Scope, elem: ET.Element) -> str:
-        """ROS 1's xacro command line: ``--inorder`` / ``-i`` (the default since melodic,
-        accepted and ignored), ``--xacro-ns``, ``-o FILE`` (the output is the parameter
-        anyway), ``name:=value`` mappings and one input file."""
-        files: list[str] = []
-        mappings: dict[str, str] = {}
-        xacro_ns = False
-        skip = False
-        for a in argv:
-            if skip:
-                skip = False
-            elif a in ("--inorder", "-i", "--legacy", "--check-order"):
-                continue
-            elif a == "--xacro-ns":
-                xacro_ns = True
-            elif a in ("-o", "--output"):
-                skip = True
-            elif ":=" in a:
-                name, value = a.split(":=", 1)
-                mappings[name] = value
-            elif a.startswith("-"):
-                raise LaunchError(f"{_where(scope, elem)}: xacro option {a!r} is not supported")
-            else:
-                files.append(a)
-        if len(files) != 1:
-            raise LaunchError(f"{_where(scope, elem)}: xacro command needs one input file")
-        try:
-            return robot_description(
-                Path(files[0]), mappings, package_path=self.package_path, xacro_ns=xacro_ns
-            )
-        except DescriptionError as err:
-            raise LaunchError(f"{_where(scope, elem)}: {err}") from err
-
-
-def _xacro_argv(argv: list[str]) -> list[str] | None:
-    """The xacro arguments of a ``command=`` running xacro in any of ROS 1's spellings
-    (``xacro``, ``xacro.py``, ``$(find xacro)/xacro[.py]``, ``python[3] .../xacro.py``,
-    ``rosrun xacro xacro[.py]``), else ``None``."""
-    rest = list(argv)
-    if rest and Path(rest[0]).name in ("python", "python2", "python3"):
-        rest = rest[1:]
-    if len(rest) >= 3 and rest[0] == "rosrun" and rest[1] == "xacro":
-        rest = rest[2:]
-    if rest and Path(rest[0]).name in ("xacro", "xacro.py"):
-        return rest[1:]
-    return None
-
 
 def _join(ns: str, name: str) -> str:
     if name.startswith("/"):
         return name
     base = ns.rstrip("/")
     return f"{base}/{name}" if name else (base or "/")
+
+
+def _rel(prefix: str, name: str) -> str:
+    """``name`` in ``prefix`` (both relative; an absolute ``name`` stays as it is)."""
+    if name.startswith("/") or not prefix:
+        return name
+    return f"{prefix.rstrip('/')}/{name}" if name else prefix
 
 
 def _flatten(data: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
@@ -488,20 +537,27 @@ def _flatten(data: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
 
 def _typed(text: str, declared: str | None = None) -> Any:
     """A ``<param value>`` as roslaunch types it (or as ``type=`` says)."""
-    if declared == "str" or declared == "string":
-        return text
-    if declared == "yaml":
-        return yaml.safe_load(text)
+    kind = (declared or "auto").strip().lower()
     t = text.strip()
-    if declared in ("int", "double", "bool"):
+    if kind in ("str", "string"):
+        return text
+    if kind == "yaml":
         try:
-            if declared == "int":
-                return int(t)
-            if declared == "double":
-                return float(t)
-            return t.lower() in _TRUE
+            return yaml.safe_load(text)
+        except yaml.YAMLError as err:
+            problem = " ".join(str(err).split())
+            raise LaunchError(f"param value is not valid YAML: {problem}") from err
+    if kind in ("bool", "boolean"):
+        if t.lower() not in _TRUE | _FALSE:
+            raise LaunchError(f"param value {text!r} is not a valid bool (true/false/1/0)")
+        return t.lower() in _TRUE
+    if kind in ("int", "double"):
+        try:
+            return int(t) if kind == "int" else float(t)
         except ValueError as err:
-            raise LaunchError(f"param value {text!r} is not a valid {declared}") from err
+            raise LaunchError(f"param value {text!r} is not a valid {kind}") from err
+    if kind != "auto":
+        raise LaunchError(f"unknown param type {declared!r} (str, int, double, bool, yaml)")
     if t.lower() in ("true", "false"):
         return t.lower() == "true"
     for conv in (int, float):
@@ -526,3 +582,6 @@ def load_launch(
         raise LaunchError(f"{p}: no such launch file")
     reader.read_file(p, dict(args or {}))
     return reader.spec
+
+
+_xacro_argv = xacro_argv  # the name the tests know

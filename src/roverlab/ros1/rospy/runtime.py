@@ -27,7 +27,11 @@ from roverlab.core.transport.zenoh import ZenohTransport, query_parameters
 from roverlab.ros1.rospy import rostime
 from roverlab.ros1.rospy.exceptions import ROSException, ROSInitException, ROSInterruptException
 
-__all__ = ["RUNTIME", "CommandLine", "Runtime", "parse_command_line"]
+__all__ = ["LAUNCH_PARAMS_ENV", "RUNTIME", "CommandLine", "Runtime", "parse_command_line"]
+
+LAUNCH_PARAMS_ENV = "ROVERLAB_LAUNCH_PARAMS"
+"""Names the YAML file (``{private: {...}, global: {...}}``) in which ``roverlab launch``
+gives a script node the parameters roslaunch would set on the parameter server."""
 
 _SPECIAL = ("__name", "__ns", "__log", "__ip", "__hostname", "__master")
 
@@ -123,7 +127,9 @@ class Runtime:
                 base, namespace=cl.special.get("__ns", "/"), remappings=cl.remaps
             )
             self.node = node
-            self.private = dict(cl.params)
+            launched = _launch_params()
+            self.params = {**launched.get("global", {}), **self.params}
+            self.private = {**launched.get("private", {}), **cl.params}  # argv wins, as in ROS
             for name_, value in self.private.items():
                 self._mirror(name_, value)
             rostime.set_clock(context.executor.clock_now_ns)
@@ -282,18 +288,20 @@ class Runtime:
         return resolve_name(name, ns) if name != "/" else "/"
 
     def get_param(self, name: str) -> Any:
-        """The value of a parameter, or KeyError."""
+        """The value of a parameter (a namespace as a dictionary, as rospy), or KeyError."""
         if name.startswith("~"):
-            key = name[1:].lstrip("/")
-            if key in self.private:
-                return self.private[key]
-            raise KeyError(name)
+            return _lookup(self.private, name[1:].strip("/"), name)
         full = self.resolve(name)
-        if full in self.params:
-            return self.params[full]
+        try:
+            return _lookup(self.params, full.rstrip("/") or "/", name)
+        except KeyError:
+            pass
         own = self.node.get_fully_qualified_name() + "/" if self.node is not None else None
-        if own is not None and full.startswith(own) and full[len(own) :] in self.private:
-            return self.private[full[len(own) :]]
+        if own is not None and full.startswith(own):
+            try:
+                return _lookup(self.private, full[len(own) :].strip("/"), name)
+            except KeyError:
+                pass
         return self._remote_param(full)
 
     def _remote_param(self, full: str) -> Any:
@@ -331,6 +339,42 @@ class Runtime:
             self._mirror(key, value)
         else:
             self.params[self.resolve(name)] = value
+
+
+def _lookup(store: dict[str, Any], key: str, name: str) -> Any:
+    """``store[key]``, or the parameters under ``key/`` as a nested dictionary (rospy's
+    answer for a namespace), else KeyError(name)."""
+    if key in store:
+        return store[key]
+    prefix = "" if key in ("", "/") else key + "/"
+    found: dict[str, Any] = {}
+    for k, v in store.items():
+        if k.startswith(prefix) and k != prefix:
+            *path, leaf = k[len(prefix) :].strip("/").split("/")
+            where = found
+            for part in path:
+                nxt = where.setdefault(part, {})
+                if not isinstance(nxt, dict):
+                    break
+                where = nxt
+            else:
+                where[leaf] = v
+    if not found:
+        raise KeyError(name)
+    return found
+
+
+def _launch_params() -> dict[str, Any]:
+    """The parameters ``roverlab launch`` gave this script (:data:`LAUNCH_PARAMS_ENV`)."""
+    path = os.environ.get(LAUNCH_PARAMS_ENV)
+    if not path:
+        return {}
+    try:
+        with open(path, encoding="utf-8") as f:
+            data = yaml.safe_load(f)
+    except (OSError, yaml.YAMLError) as err:
+        raise ROSInitException(f"{LAUNCH_PARAMS_ENV}={path}: cannot read: {err}") from err
+    return data if isinstance(data, dict) else {}
 
 
 def _default_context() -> Context:

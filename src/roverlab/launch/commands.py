@@ -1,0 +1,86 @@
+"""``<param command="...">``: xacro in-process (ROS 1's spellings), other commands in a
+shell."""
+
+from __future__ import annotations
+
+import shlex
+import subprocess
+from pathlib import Path
+
+from roverlab.description import robot_description
+from roverlab.description.errors import DescriptionError
+from roverlab.launch.errors import LaunchError
+
+__all__ = ["command_value", "xacro_argv"]
+
+
+def command_value(command: str, where: str, package_path: tuple[str, ...] = ()) -> str:
+    """The output of ``command`` (``where`` names the file and element in errors): xacro
+    runs in-process (roverlab's hooked xacro); others in a shell.
+
+    Raises:
+        LaunchError: the command cannot be parsed, is not found or exits non-zero.
+    """
+    try:
+        argv = shlex.split(command)
+    except ValueError as err:
+        raise LaunchError(f"{where}: cannot parse command: {err}") from err
+    xacro = xacro_argv(argv)
+    if xacro is not None:
+        return _xacro(xacro, where, package_path)
+    try:
+        done = subprocess.run(command, shell=True, capture_output=True, text=True, check=False)
+    except OSError as err:
+        raise LaunchError(f"{where}: command failed: {err}") from err
+    if done.returncode != 0:
+        first = (done.stderr.strip().splitlines() or ["no output"])[0]
+        raise LaunchError(f"{where}: command exited {done.returncode}: {first}")
+    return done.stdout
+
+
+def _xacro(argv: list[str], where: str, package_path: tuple[str, ...]) -> str:
+    """ROS 1's xacro command line: ``--inorder`` / ``-i`` (the default since melodic,
+    accepted and ignored), ``--xacro-ns``, ``-o FILE`` (the output is the parameter
+    anyway), ``name:=value`` mappings and one input file."""
+    files: list[str] = []
+    mappings: dict[str, str] = {}
+    xacro_ns = False
+    skip = False
+    for a in argv:
+        if skip:
+            skip = False
+        elif a in ("--inorder", "-i", "--legacy", "--check-order"):
+            continue
+        elif a == "--xacro-ns":
+            xacro_ns = True
+        elif a in ("-o", "--output"):
+            skip = True
+        elif ":=" in a:
+            name, value = a.split(":=", 1)
+            mappings[name] = value
+        elif a.startswith("-"):
+            raise LaunchError(f"{where}: xacro option {a!r} is not supported")
+        else:
+            files.append(a)
+    if len(files) != 1:
+        raise LaunchError(f"{where}: xacro command needs one input file")
+    try:
+        return robot_description(
+            Path(files[0]), mappings, package_path=package_path, xacro_ns=xacro_ns
+        )
+    except DescriptionError as err:
+        raise LaunchError(f"{where}: {err}") from err
+
+
+def xacro_argv(argv: list[str]) -> list[str] | None:
+    """The xacro arguments of a ``command=`` running xacro in any of ROS 1's spellings
+    (``xacro``, ``xacro.py``, ``$(find xacro)/xacro[.py]``, ``python[3] .../xacro.py``,
+    ``rosrun xacro xacro[.py]``), else ``None``."""
+    rest = list(argv)
+    if rest and Path(rest[0]).name in ("python", "python2", "python3"):
+        rest = rest[1:]
+    if len(rest) >= 3 and rest[0] == "rosrun" and rest[1] == "xacro":
+        rest = rest[2:]
+    if rest and Path(rest[0]).name in ("xacro", "xacro.py"):
+        return rest[1:]
+    return None

@@ -1,0 +1,167 @@
+"""A ``<node>`` that is the user's own rospy script: run in a process of its own.
+
+roslaunch starts every node as a process. roverlab's own nodes run inside the launch's
+process; a Python script of the user's package (``<node pkg="my_pkg" type="talker.py">``)
+runs as roslaunch runs it, in a child process (``roverlab run SCRIPT``) joined to the
+launch through the local daemon, with the ``<node>``'s arguments, remappings, name,
+namespace, ``<env>``, ``cwd`` and ``launch-prefix``. Its private parameters and the
+launch's global ones reach rospy's ``get_param`` through a YAML file named by
+``ROVERLAB_LAUNCH_PARAMS`` (ROS 1's parameter server, for that one process).
+"""
+
+from __future__ import annotations
+
+import os
+import shlex
+import signal
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+from typing import IO, Any
+
+import yaml
+
+from roverlab.description import find_package
+from roverlab.description.errors import DescriptionError
+from roverlab.launch.xml import LaunchError, NodeSpec
+from roverlab.ros1.rospy.runtime import LAUNCH_PARAMS_ENV
+
+__all__ = ["ScriptProcess", "ScriptProcesses", "find_script", "is_python_script", "ros_home"]
+
+# roslaunch's escalation when it stops a process: SIGINT, then SIGTERM, then SIGKILL
+_TIMEOUT_SIGINT_S = 15.0
+_TIMEOUT_SIGTERM_S = 2.0
+
+
+def find_script(spec: NodeSpec, package_path: tuple[str, ...] = ()) -> Path | None:
+    """The file ``spec.type`` in package ``spec.pkg`` (searched through the package's
+    folders, as roslaunch finds a node's executable), or ``None``."""
+    try:
+        folder = find_package(spec.pkg, package_path)
+    except DescriptionError:
+        return None
+    if "/" in spec.type or not spec.type:
+        return None
+    matches = sorted(p for p in folder.rglob(spec.type) if p.is_file())
+    return matches[0] if matches else None
+
+
+def is_python_script(path: Path) -> bool:
+    """``*.py``, or a first line ``#!...python...``."""
+    if path.suffix == ".py":
+        return True
+    try:
+        with path.open("rb") as f:
+            first = f.readline(200)
+    except OSError:
+        return False
+    return first.startswith(b"#!") and b"python" in first
+
+
+def ros_home() -> Path:
+    """``$ROS_HOME``, else ``~/.ros``: roslaunch's working directory for its nodes."""
+    home = Path(os.environ.get("ROS_HOME") or Path.home() / ".ros")
+    home.mkdir(parents=True, exist_ok=True)
+    return home
+
+
+class ScriptProcess:
+    """One script node's process: started at construction, stopped with :meth:`stop`.
+
+    Args:
+        spec: the ``<node>``.
+        script: the script file.
+        clock: ``roverlab run --clock`` (``wall`` or ``external``: the launch's clock).
+        params: the launch's global parameters (absolute names).
+    """
+
+    def __init__(self, spec: NodeSpec, script: Path, *, clock: str, params: dict[str, Any]) -> None:
+        self.spec = spec
+        self.script = script
+        self._params_file = _write_params(spec, params)
+        argv = [*shlex.split(spec.launch_prefix), sys.executable, "-m", "roverlab.cli", "run"]
+        argv += ["--clock", clock, str(script), *shlex.split(spec.args)]
+        argv += [f"{k}:={v}" for k, v in spec.remaps.items()]
+        argv += [f"__name:={spec.name}", f"__ns:={spec.namespace}"]
+        self.argv = argv
+        env = {**os.environ, **spec.env, LAUNCH_PARAMS_ENV: self._params_file}
+        env["PYTHONUNBUFFERED"] = "1"  # its lines in order with the launch's
+        cwd = script.parent if spec.cwd == "node" else ros_home()
+        self._log: IO[bytes] | None = None
+        stdout: IO[bytes] | None = None
+        if spec.output == "log":  # roslaunch: stdout to the node's log file, stderr on screen
+            log_dir = Path(os.environ.get("ROVERLAB_LOG_DIR", Path.home() / ".roverlab" / "log"))
+            log_dir.mkdir(parents=True, exist_ok=True)
+            self._log = stdout = (log_dir / f"{spec.name}.log").open("ab")
+        try:
+            self.popen = subprocess.Popen(argv, env=env, cwd=cwd, stdout=stdout)
+        except OSError as err:
+            self._cleanup()
+            raise LaunchError(f"{spec.source}: cannot start {argv[0]}: {err.strerror}") from err
+
+    @property
+    def pid(self) -> int:
+        return self.popen.pid
+
+    def poll(self) -> int | None:
+        """The exit code once the process has ended, else ``None``."""
+        return self.popen.poll()
+
+    def stop(self) -> None:
+        """SIGINT (rospy's shutdown hooks run), then SIGTERM, then SIGKILL, as roslaunch."""
+        for sig, timeout_s in (
+            (signal.SIGINT, _TIMEOUT_SIGINT_S),
+            (signal.SIGTERM, _TIMEOUT_SIGTERM_S),
+            (signal.SIGKILL, None),
+        ):
+            if self.popen.poll() is not None:
+                break
+            self.popen.send_signal(sig)
+            try:
+                self.popen.wait(timeout_s)
+            except subprocess.TimeoutExpired:
+                continue
+        self._cleanup()
+
+    def _cleanup(self) -> None:
+        if self._log is not None:
+            self._log.close()
+            self._log = None
+        Path(self._params_file).unlink(missing_ok=True)
+
+
+def _write_params(spec: NodeSpec, params: dict[str, Any]) -> str:
+    """The node's private parameters and the launch's global ones, in a temporary YAML
+    file (a ``robot_description`` is too long for an environment variable)."""
+    fd, name = tempfile.mkstemp(prefix=f"roverlab-{spec.name}-", suffix=".yaml")
+    with os.fdopen(fd, "w", encoding="utf-8") as f:
+        yaml.safe_dump({"private": dict(spec.params), "global": dict(params)}, f)
+    return name
+
+
+class ScriptProcesses:
+    """The launch's script processes, stopped when its context shuts down (attached to
+    the context as a transport: :meth:`close` is the context's shutdown hook)."""
+
+    def __init__(self) -> None:
+        self.processes: list[ScriptProcess] = []
+
+    def attach(self, context: Any) -> None:
+        pass
+
+    def on_node(self, node: Any, added: bool) -> None:
+        pass
+
+    def on_publisher(self, pub: Any, added: bool) -> None:
+        pass
+
+    def on_subscription(self, sub: Any, added: bool) -> None:
+        pass
+
+    def close(self) -> None:
+        for proc in self.processes:
+            if proc.poll() is None:
+                proc.popen.send_signal(signal.SIGINT)  # all at once: their hooks run together
+        for proc in self.processes:
+            proc.stop()
