@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import logging
 from typing import Any
 
 from roverlab.cli.main import main
@@ -21,9 +22,17 @@ def collect(ctx: Context, topics: dict[str, Any]) -> dict[str, list[Any]]:
 
 
 def run_main(argv: list[str]) -> int:
-    """The ``roverlab`` entry point in this process: its exit code."""
+    """The ``roverlab`` entry point in this process: its exit code. The ``roverlab``
+    logger's set-up (the command points its handler at this test's captured stderr) is put
+    back afterwards, so later tests in the process log as before."""
+    logger = logging.getLogger("roverlab")
+    saved = (list(logger.handlers), logger.level, logger.propagate)
     try:
         main(argv)
     except SystemExit as done:
         return int(done.code or 0)
+    finally:
+        logger.handlers[:] = saved[0]
+        logger.setLevel(saved[1])
+        logger.propagate = saved[2]
     return 0
