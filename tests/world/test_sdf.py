@@ -562,3 +562,26 @@ def test_pose_in_degrees_and_quaternions(tmp_path: Path) -> None:
 </model>"""
     w = load_sdf(write(tmp_path / "w.world", world_sdf(body, "1.9")))
     assert [tf(s).yaw for s in w.shapes] == pytest.approx([math.pi / 2, math.pi / 2])
+
+
+def test_models_gazebo_would_move_are_named_in_a_note(tmp_path: Path) -> None:
+    _model_dir(tmp_path / "m", "crate")  # <static>1</static> in its own file
+    movable = box_model("cart", "2 0 0 0 0 0").replace("<static>1</static>", "")
+    falsy = box_model("ball", "4 0 0 0 0 0").replace("<static>1</static>", "<static>0</static>")
+    body = (
+        box_model("wall", "0 0 0 0 0 0")
+        + movable
+        + falsy
+        + "<include><uri>model://crate</uri><name>kept</name></include>"
+        + "<include><uri>model://crate</uri><name>pushed</name><static>false</static></include>"
+        + "<model name='marker'><pose>0 0 0 0 0 0</pose><link name='l'/></model>"  # nothing to hit
+    )
+    w = load_sdf(write(tmp_path / "w.world", world_sdf(body)), model_path=[tmp_path / "m"])
+    assert len(w.shapes) == 5  # all kept, as fixed obstacles
+    assert w.notes == (
+        f"{tmp_path / 'w.world'}: 3 models not <static> (Gazebo lets a robot push them) kept as "
+        "fixed obstacles: cart, ball, pushed",
+    )
+    assert w.warnings == ()
+    still = load_sdf(write(tmp_path / "s.world", world_sdf(box_model("wall", "0 0 0 0 0 0"))))
+    assert still.notes == ()

@@ -149,7 +149,7 @@ def launch(
         report_warnings(f"launch {path.name}", started.warnings, strict)
         report_warnings("Gazebo world", started.world_warnings, strict)
         report_warnings("spawned robot", started.robot_warnings, strict)
-        report_notes(started.robot_notes)
+        report_notes(started.notes)
     names = ", ".join(n.get_fully_qualified_name() for n in started.nodes)
     typer.echo(f"started {len(started.nodes)} nodes: {names}", err=True)
     for name, (_, proc) in started.processes.items():

@@ -177,7 +177,7 @@ def _run(
         report_warnings(
             f"robot {simulation.robot_model.name}", robot_warnings(simulation.robot_model), strict
         )
-        report_notes(robot_notes(simulation.robot_model))
+        report_notes([*simulation.world_model.notes, *robot_notes(simulation.robot_model)])
         expose_if_asked(ctx, context, expose, pace)
     recorder = guard.recorder
     cfg = simulation.config

@@ -203,8 +203,9 @@ class Launch:
     """The Gazebo world's warnings, grouped (models and meshes not found, ...)."""
     robot_warnings: list[str] = field(default_factory=list)
     """The spawned robot's warnings (urdfdom's, unsupported plugins and sensors)."""
-    robot_notes: list[str] = field(default_factory=list)
-    """The spawned robot's Gazebo settings that the simulator does not act on."""
+    notes: list[str] = field(default_factory=list)
+    """What the world and the spawned robot say that the simulator does not act on
+    (non-static models, links' contact settings): notes, not warnings."""
 
 
 def build_launch(
@@ -238,7 +239,7 @@ def build_launch(
             raise LaunchError(f"{state.spawns[1][2]}: one robot per simulation is supported")
         robot, (x, y, yaw), _ = state.spawns[0]
         launch.robot_warnings = robot_warnings(robot)
-        launch.robot_notes = robot_notes(robot)
+        launch.notes += robot_notes(robot)
         launch.simulator = SimulatorNode(
             context=context,
             scene=state.world.to_scene(),
@@ -260,5 +261,6 @@ def build_launch(
         state.warnings.append(f"{state.world_source}: a world without a spawned robot")
     if state.world is not None:
         launch.world_warnings = world_warnings(state.world)
+        launch.notes[:0] = state.world.notes
     launch.warnings = state.warnings
     return launch

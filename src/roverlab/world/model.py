@@ -278,6 +278,8 @@ class World:
         floor_rgb, sky_rgb: colours of the ground plane (z = 0) and of empty space.
         source: the file the world was loaded from, if any.
         warnings: one line per element the loader skipped (meshes, robots, ...).
+        notes: what the file says that is loaded otherwise than Gazebo would run it, and
+            is not a fault of the file (non-static models kept as fixed obstacles).
     """
 
     name: str = "default"
@@ -288,6 +290,7 @@ class World:
     sky_rgb: RGB = DEFAULT_SKY_RGB
     source: Path | None = None
     warnings: tuple[str, ...] = ()
+    notes: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         _set(self, "shapes", tuple(self.shapes))

@@ -113,6 +113,16 @@ def _package_model_paths(world_dir: Path) -> list[Path]:
     return []
 
 
+def _movable_note(path: Path, names: list[str]) -> tuple[str, ...]:
+    if not names:
+        return ()
+    shown = ", ".join(names[:8]) + (f" and {len(names) - 8} more" if len(names) > 8 else "")
+    return (
+        f"{path}: {len(names)} model{'s' if len(names) != 1 else ''} not <static> (Gazebo "
+        f"lets a robot push them) kept as fixed obstacles: {shown}",
+    )
+
+
 def model_search_path(
     model_path: Sequence[str | os.PathLike[str]] = (), world_dir: Path | None = None
 ) -> list[Path]:
@@ -169,6 +179,7 @@ class _SdfLoader(SdfShapeReader):
     def __init__(self, search: list[Path]) -> None:
         self.search = search
         self.warnings: list[str] = []
+        self.movable: list[str] = []  # top-level models Gazebo would move (not <static>)
         self.shapes: list[Shape] = []
         self.floor_rgb: RGB | None = None
         self.include_stack: list[Path] = []
@@ -217,6 +228,7 @@ class _SdfLoader(SdfShapeReader):
             sky_rgb=sky,
             source=path,
             warnings=tuple(self.warnings),
+            notes=_movable_note(path, self.movable),
         )
 
     def _warn(self, doc: XmlDoc, el: ET.Element, msg: str) -> None:
@@ -313,6 +325,7 @@ class _SdfLoader(SdfShapeReader):
                 self._warn(doc, el, f"{ilabel}: {uri} holds no <model>: skipped")
             return
         name = _text(el.find("name")) or model_el.get("name", "")
+        static = _text(el.find("static"))  # an <include>'s <static> replaces the model's
         override = None
         if el.find("pose") is not None:
             pose, frame = self._pose(doc, el, ilabel)
@@ -322,8 +335,9 @@ class _SdfLoader(SdfShapeReader):
         self.include_stack.append(key)
         try:
             self._model(
-                inc, model_el, parent_tf, states.get(name), label, name=name, world_pose=override
-            )
+                inc, model_el, parent_tf, states.get(name), label, name=name,
+                world_pose=override, static=static,
+            )  # fmt: skip
         finally:
             self.include_stack.pop()
 
@@ -391,6 +405,7 @@ class _SdfLoader(SdfShapeReader):
         name: str,
         world_pose: Transform3 | None = None,
         scope: _Scope | None = None,
+        static: str = "",
     ) -> None:
         mlabel = _join(label, f"model {name!r}")
         robot_signs = [t for t in ("sensor", "plugin") if next(el.iter(t), None) is not None]
@@ -401,6 +416,9 @@ class _SdfLoader(SdfShapeReader):
                 f"{mlabel} has <{robot_signs[0]}> elements, so it is taken for a robot: skipped",
             )
             return
+        movable = (static or _text(el.find("static"))) not in ("1", "true")
+        if not label and movable and el.find(".//collision") is not None:
+            self.movable.append(name)  # Gazebo's physics would move it
         if state is not None and state.pose is not None:
             model_tf = state.pose
         elif world_pose is not None:
