@@ -252,8 +252,8 @@ def _measure(
         "() => { if (viz.redraw) { viz.redraw.continuous = false; viz.redraw.maxFps = null; } }"
     )
     live_fps, live_cpu = _draws(page, view, min(seconds, 5.0))
-    paused.set()  # idle: nothing published, nothing moves
-    page.wait_for_timeout(1000)
+    paused.set()  # idle: nothing published, nothing moves (a slow page drains its backlog first)
+    page.wait_for_timeout(3000)
     idle_fps, idle_cpu = _draws(page, view, min(seconds, 5.0))
     paused.clear()
     page.close()
