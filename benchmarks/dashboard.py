@@ -13,8 +13,13 @@ the 2D view, and prints for each (the 3D view twice: with its adaptive resolutio
 lowers the drawing-buffer resolution down to half per axis while the frame rate is below 28,
 and at fixed full resolution):
 
-- frames per second the page renders, counted with ``requestAnimationFrame`` in the browser
-  over the window (target >= 30);
+- frames per second the page renders when made to redraw every animation frame, with no
+  Frame Rate cap (``viz.redraw.continuous``, ``maxFps = Infinity``): the render speed,
+  counted as frames drawn (the views' own counters) over the window (target >= 30);
+- frames drawn per second as the page is used (it draws only when something changed, at most
+  rviz's Frame Rate, 30) with the data streaming, and with the publishers paused (idle: none),
+  and chromium's CPU share in both (all processes below this one: the browser and
+  Playwright's driver);
 - the server's CPU share while one page is connected: CPU time of this process (the
   dashboard plus the tiny publishers) over the wall time of the window, in % of one core;
 - bytes the websocket carried per second, and how long the first map took to appear.
@@ -30,6 +35,7 @@ import math
 import os
 import platform
 import sys
+import threading
 import time
 from pathlib import Path
 from typing import Any
@@ -81,7 +87,9 @@ def _depth_cloud() -> np.ndarray:
     return np.column_stack((x.ravel(), y.ravel(), z.ravel())).astype(np.float32)
 
 
-def _system(ctx: Context, cells: int, update_every_s: float | None) -> None:
+def _system(
+    ctx: Context, cells: int, update_every_s: float | None, paused: threading.Event
+) -> None:
     node = ctx.create_node("bench_pub")
     rng = np.random.default_rng(0)
     grid = np.zeros((cells, cells), dtype=np.int8)
@@ -112,6 +120,8 @@ def _system(ctx: Context, cells: int, update_every_s: float | None) -> None:
     state = {"k": 0}
 
     def tick() -> None:
+        if paused.is_set():
+            return
         now = ctx.now()
         t = now.nanoseconds * 1e-9
         pose = Transform3(
@@ -145,8 +155,55 @@ def _cpu_s() -> float:
     return t.user + t.system
 
 
+def _descendants_cpu_s() -> float:
+    """CPU seconds (user + system) of the processes below this one (chromium, Playwright's
+    driver), from /proc; NaN where there is no /proc."""
+    tick = os.sysconf("SC_CLK_TCK")
+    parent: dict[int, int] = {}
+    cpu: dict[int, float] = {}
+    try:
+        entries = [d for d in Path("/proc").iterdir() if d.name.isdigit()]
+    except OSError:
+        return math.nan
+    for d in entries:
+        try:
+            fields = (d / "stat").read_text().rsplit(")", 1)[1].split()
+        except (OSError, IndexError):
+            continue
+        parent[int(d.name)] = int(fields[1])
+        cpu[int(d.name)] = (int(fields[11]) + int(fields[12])) / tick
+    me, total = os.getpid(), 0.0
+    for pid, seconds in cpu.items():
+        p = parent.get(pid)
+        while p and p != me:
+            p = parent.get(p)
+        total += seconds if p == me else 0.0
+    return total
+
+
+_DRAWS_JS = """async ([view, ms]) => {
+  const read = () => view === "3d" ? viz.cam.frames : viz.data.frames;
+  const f0 = read(), t0 = performance.now();
+  await new Promise((done) => setTimeout(done, ms));
+  return (read() - f0) * 1000 / (performance.now() - t0);
+}"""
+
+
+def _draws(page: Any, view: str, seconds: float) -> tuple[float, float]:
+    """Frames the view drew per second over ``seconds``, and chromium's CPU share (%)."""
+    cpu0, wall0 = _descendants_cpu_s(), time.monotonic()
+    fps = float(page.evaluate(_DRAWS_JS, [view, seconds * 1000]))
+    return fps, 100 * (_descendants_cpu_s() - cpu0) / (time.monotonic() - wall0)
+
+
 def _measure(
-    browser: Any, server: DashboardServer, view: str, seconds: float, *, adaptive: bool = True
+    browser: Any,
+    server: DashboardServer,
+    view: str,
+    seconds: float,
+    paused: threading.Event,
+    *,
+    adaptive: bool = True,
 ) -> dict[str, float]:
     page = browser.new_page(viewport={"width": 1600, "height": 900})
     cdp: Any = page.context.new_cdp_session(page)
@@ -174,29 +231,38 @@ def _measure(
         )
     else:
         page.evaluate("() => { viz.setViewMode('2D'); viz.view.scale = 12; }")
+    # the render speed: a frame drawn every animation frame, no Frame Rate cap (a page
+    # without viz.redraw, from before it drew only on change, redraws every frame anyway)
+    page.evaluate(
+        "() => { if (viz.redraw) { viz.redraw.continuous = true;"
+        " viz.redraw.maxFps = Infinity; viz.requestDraw(); } }"
+    )
     page.wait_for_timeout(4000)  # the adaptive resolution settles
     received["bytes"] = 0
     cpu0, wall0 = _cpu_s(), time.monotonic()
-    frames = page.evaluate(
-        """(ms) => new Promise((done) => {
-             let n = 0; const end = performance.now() + ms;
-             function tick(t) {
-               n += 1;
-               if (t < end) requestAnimationFrame(tick); else done(n);
-             }
-             requestAnimationFrame(tick);
-           })""",
-        seconds * 1000,
-    )
+    fps = float(page.evaluate(_DRAWS_JS, [view, seconds * 1000]))
     wall = time.monotonic() - wall0
     cpu = _cpu_s() - cpu0
     drawn = page.evaluate("() => viz.data.layers[3].points.at(-1).n")  # the Depth display
     ms = page.evaluate("() => [viz.cam.msUpdate || 0, viz.cam.msRender || 0, viz.cam.resolution]")
     # frames drawn back to back, each waited for: the software GPU's own time per frame
     synced = page.evaluate("() => viz.renderSync(10)") if view == "3d" else 0.0
+    # as used: frames only when something changed, at most the Frame Rate (30)
+    page.evaluate(
+        "() => { if (viz.redraw) { viz.redraw.continuous = false; viz.redraw.maxFps = null; } }"
+    )
+    live_fps, live_cpu = _draws(page, view, min(seconds, 5.0))
+    paused.set()  # idle: nothing published, nothing moves (a slow page drains its backlog first)
+    page.wait_for_timeout(3000)
+    idle_fps, idle_cpu = _draws(page, view, min(seconds, 5.0))
+    paused.clear()
     page.close()
     return {
-        "fps": frames / wall,
+        "fps": fps,
+        "live_fps": live_fps,
+        "live_browser_cpu": live_cpu,
+        "idle_fps": idle_fps,
+        "idle_browser_cpu": idle_cpu,
         "wall": wall,
         "cpu": 100 * cpu / wall,
         "kib": received["bytes"] / wall / 1024,
@@ -222,7 +288,8 @@ def main() -> None:
     if not CHROMIUM.exists():
         sys.exit("needs /usr/bin/chromium (Debian's chromium package)")
     ctx = Context(clock="wall")
-    _system(ctx, args.map_cells, args.update_map_every)
+    paused = threading.Event()
+    _system(ctx, args.map_cells, args.update_map_every, paused)
     server = DashboardServer(ctx, "127.0.0.1", 0, config=_config(args.cloud_max_points))
     ctx.spin_in_thread()
     server.start()
@@ -241,7 +308,7 @@ def main() -> None:
         for view, adaptive in runs:
             if args.view not in ("both", view):
                 continue
-            r = _measure(browser, server, view, args.seconds, adaptive=adaptive)
+            r = _measure(browser, server, view, args.seconds, paused, adaptive=adaptive)
             what = (
                 ""
                 if view == "2d"
@@ -249,7 +316,18 @@ def main() -> None:
             )
             print(f"  {view.upper()} view{what} (window {r['wall']:.1f} s):")
             print(f"    first map on the page:    {r['first_map']:6.2f} s after page load")
-            print(f"    page frame rate:          {r['fps']:6.1f} fps (target >= 30)")
+            print(
+                f"    page frame rate:          {r['fps']:6.1f} fps redrawing every frame"
+                " (target >= 30)"
+            )
+            print(
+                f"    as used, data streaming:  {r['live_fps']:6.1f} frames/s drawn (Frame Rate"
+                f" 30), chromium {r['live_browser_cpu']:.0f} % of one core"
+            )
+            print(
+                f"    idle, nothing published:  {r['idle_fps']:6.1f} frames/s drawn, chromium"
+                f" {r['idle_browser_cpu']:.0f} % of one core"
+            )
             print(f"    cloud points drawn:       {r['cloud_points']:6.0f} of 307200 per frame")
             if view == "3d":
                 print(

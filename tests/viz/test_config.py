@@ -247,3 +247,28 @@ def test_saved_view_round_trips_and_bad_view_is_one_error(tmp_path: Path) -> Non
     data["view"] = {"mode": "Orbit", "distance": "far"}
     with pytest.raises(ConfigError, match=r"dash\.json: view distance must be a number"):
         config_from_dict(data, "dash.json")
+
+
+def test_rviz_frame_rate_is_read_saved_and_checked(tmp_path: Path) -> None:
+    text = (FIXTURES / "test.rviz").read_text()
+    assert "    Frame Rate: 30\n" in text
+    assert parse_rviz(text, "test.rviz").frame_rate_hz == 30.0
+    five = parse_rviz(text.replace("Frame Rate: 30", "Frame Rate: 5"), "five.rviz")
+    assert five.frame_rate_hz == 5.0
+    assert parse_rviz(text.replace("    Frame Rate: 30\n", ""), "none.rviz").frame_rate_hz == 30.0
+    path = save_config(five, tmp_path / "dash.json")
+    assert json.loads(path.read_text())["frame_rate_hz"] == 5.0
+    assert load_config(path).frame_rate_hz == 5.0
+    data = five.to_dict()
+    del data["frame_rate_hz"]  # a file saved before the option: rviz's default
+    assert config_from_dict(data).frame_rate_hz == 30.0
+    for bad in (0, -3, "fast", True):
+        data["frame_rate_hz"] = bad
+        with pytest.raises(ConfigError, match=r"dash\.json: Frame Rate must be a number >= 1"):
+            config_from_dict(data, "dash.json")
+    with pytest.raises(ConfigError, match=r"bad\.rviz: Global Options: Frame Rate must be"):
+        parse_rviz(text.replace("Frame Rate: 30", "Frame Rate: 0"), "bad.rviz")
+    with pytest.raises(ConfigError, match=r"bad\.rviz: Global Options: Frame Rate must be a"):
+        parse_rviz(text.replace("Frame Rate: 30", "Frame Rate: fast"), "bad.rviz")
+    with pytest.raises(ConfigError, match="Frame Rate must be a number >= 1"):
+        DashboardConfig(frame_rate_hz=0.5)

@@ -51,10 +51,13 @@ def _open(browser: Any, server: DashboardServer, ready: str, timeout_ms: int = 6
     page.on("pageerror", lambda e: errors.append(str(e)))
     page.goto(server.url)
     page.wait_for_function(
-        "() => window.viz && viz.cam && viz.cam.frames > 5 && viz.data.state"
+        "() => window.viz && viz.cam && viz.cam.frames > 0 && viz.data.state"
         " && viz.data.state.robot3d.length > 0 && (" + ready + ")",
         timeout=timeout_ms,
     )
+    # the page draws only when something changed: one more frame, with all that arrived
+    drawn = page.evaluate("() => { viz.requestDraw(); return viz.cam.frames; }")
+    page.wait_for_function(f"() => viz.cam.frames > {drawn}")
     page.errors = errors
     return page
 

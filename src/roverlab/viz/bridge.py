@@ -15,6 +15,7 @@ The status tree the page shows (:meth:`VizBridge.status`) is built by
 
 from __future__ import annotations
 
+import dataclasses
 import io
 import math
 import re
@@ -408,11 +409,8 @@ class VizBridge(DisplayStatus):
             images[0].enabled = True
         else:
             displays.append(DisplayConfig("image", "Image", True, topic, {}))
-        self.set_config(
-            DashboardConfig(
-                self.config.fixed_frame, displays, list(self.config.unsupported), self.config.source
-            )
-        )
+        # the rest (fixed frame, view, Frame Rate, unsupported, source) stays as it was
+        self.set_config(dataclasses.replace(self.config, displays=displays))
 
     def image_frame(self, state: DisplayState) -> Versioned | None:
         """The newest image of an image display as a JPEG/PNG frame (encoded once)."""

@@ -7,12 +7,13 @@ their defaults. Options are validated by name and type, so a misspelt key is an 
 never silently dropped.
 
 * :func:`load_rviz` reads a ``.rviz`` file (rviz 1's YAML: ``Visualization Manager`` ->
-  ``Displays`` and ``Global Options/Fixed Frame``). Display classes roverlab does not draw
-  are kept in :attr:`DashboardConfig.unsupported` (the page lists them), not an error.
+  ``Displays``, ``Global Options/Fixed Frame`` and ``Frame Rate``). Display classes
+  roverlab does not draw are kept in :attr:`DashboardConfig.unsupported` (the page lists
+  them), not an error.
 * :func:`save_config` / :func:`load_config` write and read the dashboard's own format, a
   JSON document ``{"format": "roverlab-dashboard", "version": 1, "fixed_frame": ...,
-  "displays": [{"kind", "name", "enabled", "topic", "options"}, ...]}``; :func:`load_config`
-  also accepts ``.rviz`` files (told apart by content).
+  "frame_rate_hz": 30.0, "displays": [{"kind", "name", "enabled", "topic", "options"},
+  ...]}``; :func:`load_config` also accepts ``.rviz`` files (told apart by content).
 """
 
 from __future__ import annotations
@@ -34,12 +35,14 @@ from roverlab.viz.views import check_view, default_view, view_from_rviz
 
 __all__ = [
     "CONFIG_FORMAT",
+    "DEFAULT_FRAME_RATE_HZ",
     "DISPLAY_KINDS",
     "RVIZ_CLASSES",
     "ConfigError",
     "DashboardConfig",
     "DisplayConfig",
     "DisplayKind",
+    "check_frame_rate",
     "default_config",
     "load_config",
     "load_rviz",
@@ -49,6 +52,8 @@ __all__ = [
 
 CONFIG_FORMAT: Final = "roverlab-dashboard"
 _CONFIG_VERSION: Final = 1
+DEFAULT_FRAME_RATE_HZ: Final = 30.0
+"""rviz's ``Global Options/Frame Rate`` default."""
 
 
 class ConfigError(DashboardError):
@@ -98,6 +103,8 @@ class DashboardConfig:
 
     Attributes:
         fixed_frame: rviz's ``Global Options/Fixed Frame``.
+        frame_rate_hz: rviz's ``Global Options/Frame Rate``: the most frames a second the
+            page draws (it draws only when something changed).
         view: the camera (:mod:`roverlab.viz.views`): ``{"mode": "2D"}`` or rviz's
             ``Views/Current`` (Orbit, TopDownOrtho, ThirdPersonFollower).
         displays: in panel order (drawn in this order too, later on top).
@@ -110,6 +117,10 @@ class DashboardConfig:
     unsupported: list[str] = field(default_factory=list)
     source: str = ""
     view: dict[str, Any] = field(default_factory=default_view)
+    frame_rate_hz: float = DEFAULT_FRAME_RATE_HZ
+
+    def __post_init__(self) -> None:
+        self.frame_rate_hz = check_frame_rate(self.frame_rate_hz, "dashboard config")
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON document :func:`save_config` writes."""
@@ -117,6 +128,7 @@ class DashboardConfig:
             "format": CONFIG_FORMAT,
             "version": _CONFIG_VERSION,
             "fixed_frame": self.fixed_frame,
+            "frame_rate_hz": self.frame_rate_hz,
             "displays": [d.to_dict() for d in self.displays],
             "unsupported": list(self.unsupported),
             "view": dict(self.view),
@@ -158,6 +170,20 @@ def default_config(fixed_frame: str = "map") -> DashboardConfig:
 
 
 # ------------------------------------------------------------------ validation
+def check_frame_rate(value: Any, where: str) -> float:
+    """A Frame Rate (frames a second, at least 1, as rviz's update timer needs).
+
+    Raises:
+        ConfigError: not a number, or below 1 (the message names ``where``).
+    """
+    ok = isinstance(value, int | float) and not isinstance(value, bool)
+    if not ok or not value >= 1 or value == float("inf"):
+        raise ConfigError(
+            f"{where}: Frame Rate must be a number >= 1 (frames a second), got {value!r}"
+        )
+    return float(value)
+
+
 def _check_option(where: str, kind: str, name: str, value: Any) -> Any:
     defaults = DISPLAY_KINDS[kind].options
     if name not in defaults:
@@ -249,6 +275,7 @@ def config_from_dict(data: Any, where: str = "dashboard config") -> DashboardCon
         view = check_view(data.get("view"), where)
     except DashboardError as err:
         raise ConfigError(str(err)) from err
+    rate = check_frame_rate(data.get("frame_rate_hz", DEFAULT_FRAME_RATE_HZ), where)
     return DashboardConfig(
         fixed_frame=frame.lstrip("/"),
         displays=[
@@ -257,6 +284,7 @@ def config_from_dict(data: Any, where: str = "dashboard config") -> DashboardCon
         unsupported=unsupported,
         source=where,
         view=view,
+        frame_rate_hz=rate,
     )
 
 
@@ -410,8 +438,18 @@ def parse_rviz(text: str, source: str = "<rviz>") -> DashboardConfig:
     if not isinstance(manager, Mapping):
         raise ConfigError(f"{source}: no 'Visualization Manager' section: not an .rviz file")
     options = manager.get("Global Options") or {}
+    if not isinstance(options, Mapping):
+        raise ConfigError(f"{source}: 'Global Options' must be a mapping")
     frame = str(options.get("Fixed Frame", "map")).lstrip("/") or "map"
-    config = DashboardConfig(fixed_frame=frame, source=source, view=view_from_rviz(manager))
+    rate = _rviz_number(options, "Frame Rate", f"{source}: Global Options")
+    config = DashboardConfig(
+        fixed_frame=frame,
+        source=source,
+        view=view_from_rviz(manager),
+        frame_rate_hz=check_frame_rate(
+            DEFAULT_FRAME_RATE_HZ if rate is None else rate, f"{source}: Global Options"
+        ),
+    )
     raw = manager.get("Displays") or []
     if not isinstance(raw, list):
         raise ConfigError(f"{source}: 'Displays' must be a list")

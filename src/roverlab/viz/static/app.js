@@ -6,6 +6,7 @@
   const canvas = $("view");
   const g = canvas.getContext("2d");
   const connEl = $("conn"), driveEl = $("drive-state"), noticeEl = $("notice");
+  const redraw = window.vizRedraw, requestDraw = redraw.requestDraw;  // redraw.js: draw only on change
 
   // Option widgets: choices, and which options are colours.
   const CHOICES = {
@@ -230,20 +231,28 @@
       const old = el.src;
       el.src = URL.createObjectURL(new Blob([new Uint8Array(buf, 4)], { type: mime }));
       if (old.startsWith("blob:")) URL.revokeObjectURL(old);
+      return;  // the image panel, not the view
     }
+    requestDraw();
   }
 
   function onText(msg) {
     if (msg.type === "state") onState(msg);
     else if (msg.type === "config") onConfig(msg.config);
-    else if (msg.type === "markers") { const l = layer(msg.slot); l.markers = msg.items; l.markers3d = msg.items3d || null; }
+    else if (msg.type === "markers") {
+      const l = layer(msg.slot); l.markers = msg.items; l.markers3d = msg.items3d || null; requestDraw();
+    }
     else if (msg.type === "notice") {
       noticeEl.textContent = msg.text; noticeEl.className = msg.level === "error" ? "error" : "";
     }
   }
 
+  let drawnState = "";
   function onState(msg) {
     data.state = msg;
+    // the server sends the state 10 times a second; a frame only when what is drawn moved
+    const key = JSON.stringify([msg.fixed_frame, msg.frames, msg.frames3, msg.robot, msg.robot3d, msg.displays]);
+    if (key !== drawnState) { drawnState = key; requestDraw(); }
     const base = msg.frames.base_footprint || msg.frames.base_link;
     if (!view.placed && base) { view.cx = base[0]; view.cy = base[1]; view.placed = true; }
     if (msg.topics) { data.topics = msg.topics; renderTopics(); }
@@ -283,7 +292,20 @@
   function sendConfig() {
     data.configText = JSON.stringify(data.config);
     send({ type: "config", config: data.config });
+    applyFrameRate();
+    requestDraw();
   }
+  // rviz's Global Options Frame Rate: the most frames a second either view draws
+  function applyFrameRate() {
+    const rate = data.config && data.config.frame_rate_hz;
+    redraw.frameRate = rate >= 1 ? rate : 30;
+    const inp = $("frame-rate");
+    if (document.activeElement !== inp) inp.value = redraw.frameRate;
+  }
+  $("frame-rate").onchange = () => {
+    const v = Number($("frame-rate").value);
+    if (data.config && Number.isFinite(v) && v >= 1) { data.config.frame_rate_hz = v; sendConfig(); } else applyFrameRate();
+  };
 
   function onConfig(config) {
     const text = JSON.stringify(config);
@@ -301,6 +323,8 @@
     for (const hook of configHooks) hook(config, old);
     renderDisplays();
     renderImages();
+    applyFrameRate();
+    requestDraw();
   }
 
   function colourHex(c) { return "#" + c.map((v) => v.toString(16).padStart(2, "0")).join(""); }
@@ -479,11 +503,11 @@
     fillSelect($("follow"), frames, view.follow, "");
   }
   $("fixed-frame").onchange = () => { data.config.fixed_frame = $("fixed-frame").value; sendConfig(); };
-  $("follow").onchange = () => { view.follow = $("follow").value; view.placed = true; };
-  $("rotate-follow").onchange = () => { view.rotate = $("rotate-follow").checked; };
-  $("rot-left").onclick = () => { view.angle -= Math.PI / 12; };
-  $("rot-right").onclick = () => { view.angle += Math.PI / 12; };
-  $("rot-reset").onclick = () => { view.angle = 0; view.rotate = false; $("rotate-follow").checked = false; };
+  $("follow").onchange = () => { view.follow = $("follow").value; view.placed = true; requestDraw(); };
+  $("rotate-follow").onchange = () => { view.rotate = $("rotate-follow").checked; requestDraw(); };
+  $("rot-left").onclick = () => { view.angle -= Math.PI / 12; requestDraw(); };
+  $("rot-right").onclick = () => { view.angle += Math.PI / 12; requestDraw(); };
+  $("rot-reset").onclick = () => { view.angle = 0; view.rotate = false; $("rotate-follow").checked = false; requestDraw(); };
 
   // image panels: one per enabled image display, the first with ids image-topic / camera
   function renderImages() {
@@ -569,6 +593,7 @@
     if (!L.points) return;
     const now = performance.now(), decay = (d.options.decay_s || 0) * 1000;
     if (decay > 0) L.points = L.points.filter((p, i) => i === L.points.length - 1 || now - p.t < decay);
+    if (decay > 0 && L.points.length > 1) redraw.requestDrawAt(L.points[0].t + decay);  // it fades
     const h = px(d.options.size_px || 3) / 2, s = 2 * h;
     for (const scan of L.points) {
       const st = scan.stride;
@@ -708,7 +733,6 @@
     if (view.rotate) view.angle = p[2] - Math.PI / 2;
   }
   function draw() {
-    if (view.mode && view.mode !== "2D") { requestAnimationFrame(draw); return; }  // the 3D view draws
     const w = canvas.clientWidth, h = canvas.clientHeight;
     if (canvas.width !== w || canvas.height !== h) { canvas.width = w; canvas.height = h; }
     g.setTransform(1, 0, 0, 1, 0, 0);
@@ -727,8 +751,13 @@
     }
     g.setTransform(1, 0, 0, 1, 0, 0);
     data.frames += 1;
-    requestAnimationFrame(draw);
   }
+  // one scheduler for both views: the 2D canvas here, or view3d.js's frame (viz.draw3d)
+  redraw.draw = () => {
+    if (!view.mode || view.mode === "2D") draw();
+    else if (window.viz.draw3d) window.viz.draw3d();
+  };
+  new ResizeObserver(requestDraw).observe($("main"));
 
   // ------------------------------------------------------------------ mouse
   function canvasXY(ev) {
@@ -743,10 +772,12 @@
     const mode = ev.button === 2 || (ev.button === 0 && ev.shiftKey && tool === "move") ? "rotate" : tool;
     drag = { tool: mode, px: x, py: y, wx, wy, yaw: view.angle, cx: view.cx, cy: view.cy, angle: view.angle };
     canvas.focus();
+    if (mode !== "move" && mode !== "rotate") requestDraw();  // the tool's arrow
   });
   window.addEventListener("mousemove", (ev) => {
     if (!drag || (view.mode && view.mode !== "2D")) return;
     const [x, y] = canvasXY(ev);
+    requestDraw();
     if (drag.tool === "move") {
       const c = Math.cos(view.angle), s = Math.sin(view.angle);
       const rx = -(x - drag.px) / view.scale, ry = (y - drag.py) / view.scale;
@@ -763,6 +794,7 @@
   window.addEventListener("mouseup", () => {
     if (!drag || (view.mode && view.mode !== "2D")) return;
     const d = drag; drag = null;
+    requestDraw();
     if (d.tool === "goal" || d.tool === "initialpose") send({ type: d.tool, x: d.wx, y: d.wy, yaw: d.yaw });
     else if (d.tool === "point") send({ type: "point", x: d.wx, y: d.wy });
     if (d.tool !== "move" && d.tool !== "rotate") setTool("move");  // rviz drops back to the camera tool
@@ -773,6 +805,7 @@
     const [x, y] = canvasXY(ev);
     const [wx, wy] = screenToWorld(x, y);
     view.scale = Math.min(2000, Math.max(0.5, view.scale * Math.exp(-ev.deltaY * 0.001)));
+    requestDraw();
     if (view.follow) return;  // zoom about the followed frame
     const [nx, ny] = screenToWorld(x, y);
     view.cx += wx - nx; view.cy += wy - ny;
@@ -812,8 +845,9 @@
   $("speed").onchange = sendSpeeds; $("turn").onchange = sendSpeeds;
 
   const configHooks = [];
-  window.viz = { view, data, conn, worldToScreen, screenToWorld, setTool, send, PALETTES, configHooks,
-                 getTool: () => tool, framePose };
+  // view: setting a property through it asks for a frame (redraw.watch)
+  window.viz = { view: redraw.watch(view), data, conn, worldToScreen, screenToWorld, setTool, send, PALETTES,
+                 configHooks, getTool: () => tool, framePose, redraw, requestDraw };
   connect();
-  requestAnimationFrame(draw);
+  requestDraw();
 })();

@@ -8,6 +8,7 @@ import { buildMarker, markerShapeKey, setLineResolution } from "./markers3d.js";
 
 const viz = window.viz;
 const data = viz.data;
+const requestDraw = viz.requestDraw;  // redraw.js: a frame only when something drawn changed
 const host = document.getElementById("main");
 const canvas2d = document.getElementById("view");
 const canvas = document.createElement("canvas");
@@ -39,8 +40,8 @@ ortho.up.set(0, 1, 0);
 // (centre x, y, scale px/m, angle), ThirdPersonFollower (an orbit about a frame, turning with it)
 const cam = { mode: "2D", focal: new THREE.Vector3(0, 0, 0), distance: 10, yaw: 0.785, pitch: 0.785,
               x: 0, y: 0, scale: 50, angle: 0, target: "", frames: 0, fps: 0, resolution: 1,
-              adaptive: true };
-viz.cam = cam;
+              adaptive: true, fpsCapable: 0 };
+viz.cam = viz.redraw.watch(cam);  // setting a property through viz.cam asks for a frame
 
 function setMode(mode) {
   cam.mode = mode;
@@ -49,14 +50,9 @@ function setMode(mode) {
   canvas.style.display = is3d ? "block" : "none";
   labels.style.display = is3d ? "block" : "none";
   canvas2d.style.display = is3d ? "none" : "block";
-  // benchmarks: n frames rendered back to back, each waited for (a one-pixel read), in ms per frame
-viz.renderSync = (n) => {
-  const gl = renderer.getContext(), px = new Uint8Array(4), t0 = performance.now();
-  for (let i = 0; i < n; i++) { renderer.render(scene, camera); gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, px); }
-  return (performance.now() - t0) / n;
-};
-const sel = document.getElementById("view-mode");
+  const sel = document.getElementById("view-mode");
   if (sel && sel.value !== mode) sel.value = mode;
+  requestDraw();
 }
 viz.setViewMode = setMode;
 
@@ -256,6 +252,7 @@ function updatePoints(slot, d, L) {
   });
   const now = performance.now(), decay = (d.options.decay_s || 0) * 1000;
   if (decay > 0) L.points = L.points.filter((p, i) => i === L.points.length - 1 || now - p.t < decay);
+  if (decay > 0 && L.points.length > 1) viz.redraw.requestDrawAt(L.points[0].t + decay);  // it fades
   const key = L.points.length + ":" + (L.version || 0);
   e.obj.material.size = d.options.size_px || 3;
   e.obj.material.transparent = d.options.alpha < 1;
@@ -298,7 +295,7 @@ function loadMesh(index, geometry, rgba, alpha) {
   holder.scale.set(...geometry.scale);
   const url = `mesh/${index}${meshQuery}`, name = geometry.filename.toLowerCase();
   const a = rgba[3] * alpha;
-  const done = (obj) => { holder.add(obj); viz.meshes.loaded += 1; };
+  const done = (obj) => { holder.add(obj); viz.meshes.loaded += 1; requestDraw(); };
   const fail = (err) => { viz.meshes.failed += 1; console.warn("mesh", geometry.filename, err); };
   if (name.endsWith(".stl")) {
     new STLLoader().load(url, (geo) => {
@@ -547,6 +544,7 @@ canvas.addEventListener("mousedown", (ev) => {
     const p = groundPoint(ev.clientX, ev.clientY);
     if (!p) return;
     drag = { tool, x: ev.clientX, y: ev.clientY, p, yaw: 0 };
+    requestDraw();  // the tool's arrow
     return;
   }
   const mode = ev.button === 1 || (ev.button === 0 && ev.shiftKey) ? "pan" : ev.button === 2 ? "zoom" : "rotate";
@@ -555,6 +553,7 @@ canvas.addEventListener("mousedown", (ev) => {
 window.addEventListener("mousemove", (ev) => {
   if (!drag || cam.mode === "2D") return;
   const dx = ev.clientX - drag.x, dy = ev.clientY - drag.y;
+  requestDraw();
   if (drag.tool !== "camera") {
     const q = groundPoint(ev.clientX, ev.clientY);
     if (q && Math.hypot(dx, dy) > 3) drag.yaw = Math.atan2(q.y - drag.p.y, q.x - drag.p.x);
@@ -583,6 +582,7 @@ window.addEventListener("mousemove", (ev) => {
 window.addEventListener("mouseup", () => {
   if (!drag) return;
   const d = drag; drag = null;
+  requestDraw();
   if (d.tool === "goal" || d.tool === "initialpose") viz.send({ type: d.tool, x: d.p.x, y: d.p.y, yaw: d.yaw });
   else if (d.tool === "point") viz.send({ type: "point", x: d.p.x, y: d.p.y });
   if (d.tool !== "camera") viz.setTool("move");
@@ -591,13 +591,15 @@ canvas.addEventListener("wheel", (ev) => {
   ev.preventDefault();
   if (cam.mode === "TopDownOrtho") cam.scale = Math.min(2000, Math.max(0.5, cam.scale * Math.exp(-ev.deltaY * 0.001)));
   else cam.distance = Math.max(0.05, cam.distance * Math.exp(ev.deltaY * 0.001));
+  requestDraw();
 }, { passive: false });
 
 // ------------------------------------------------------------------- loop
-let fpsT0 = performance.now(), fpsN = 0;
+// Drawn by redraw.js's scheduler (viz.draw3d) only when something changed, at most Frame
+// Rate times a second. cam.fps: frames drawn per second (low when little changes).
+let fpsT0 = performance.now(), fpsN = 0, lastSync = -Infinity;
+const costs = [];  // ms per needed frame, GPU work included (see below)
 function frame() {
-  requestAnimationFrame(frame);
-  if (cam.mode === "2D") return;
   const w = host.clientWidth, h = host.clientHeight;
   const pr = renderer.getPixelRatio();
   if (canvas.width !== Math.floor(w * pr) || canvas.height !== Math.floor(h * pr)) renderer.setSize(w, h, false);
@@ -613,6 +615,15 @@ function frame() {
   setLineResolution(w, h);
   renderer.render(scene, camera);
   const t2 = performance.now();
+  // what a frame costs, the (software) GPU's work included: at most 4 times a second a drawn
+  // frame waits for it (a one-pixel read). Only frames that were needed are judged, so an
+  // idle view never changes its resolution.
+  if (cam.adaptive && t2 - lastSync >= 250) {
+    const gl = renderer.getContext();
+    gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, new Uint8Array(4));
+    lastSync = performance.now();
+    costs.push(lastSync - t0);
+  }
   placeLabels(camera, w, h);
   cam.msUpdate = 0.9 * (cam.msUpdate || 0) + 0.1 * (t1 - t0);
   cam.msRender = 0.9 * (cam.msRender || 0) + 0.1 * (t2 - t1);
@@ -620,13 +631,26 @@ function frame() {
   const now = performance.now();
   if (now - fpsT0 >= 1000) {
     cam.fps = fpsN * 1000 / (now - fpsT0); fpsN = 0; fpsT0 = now;
-    // adaptive resolution: a slow (software) renderer draws fewer pixels, down to half per
-    // axis, to keep the view interactive; back to full resolution when there is headroom
-    const r = cam.resolution;
-    if (!cam.adaptive) cam.resolution = 1;
-    else if (cam.fps < 28 && r > 0.5) cam.resolution = Math.max(0.5, r - 0.125);
-    else if (cam.fps > 50 && r < 1) cam.resolution = Math.min(1, r + 0.125);
-    if (cam.resolution !== r) renderer.setPixelRatio(cam.resolution * (window.devicePixelRatio || 1));
+    adaptResolution();
+  }
+}
+viz.draw3d = frame;
+// adaptive resolution: a slow (software) renderer draws fewer pixels, down to half per axis,
+// to keep the view interactive (>= 28 frames a second); back to full resolution when there
+// is headroom (> 50)
+function adaptResolution() {
+  const r = cam.resolution;
+  if (!cam.adaptive) cam.resolution = 1;
+  else if (costs.length >= 3) {
+    cam.fpsCapable = 1000 * costs.length / costs.reduce((a, b) => a + b, 0);
+    costs.length = 0;
+    if (cam.fpsCapable < 28 && r > 0.5) cam.resolution = Math.max(0.5, r - 0.125);
+    else if (cam.fpsCapable > 50 && r < 1) cam.resolution = Math.min(1, r + 0.125);
+  }
+  if (cam.resolution !== r) {
+    renderer.setPixelRatio(cam.resolution * (window.devicePixelRatio || 1));
+    costs.length = 0;
+    requestDraw();  // the canvas was resized (and cleared)
   }
 }
 // benchmarks: n frames rendered back to back, each waited for (a one-pixel read), in ms per frame
@@ -637,4 +661,4 @@ viz.renderSync = (n) => {
 };
 const sel = document.getElementById("view-mode");
 if (sel) sel.onchange = () => setMode(sel.value);
-requestAnimationFrame(frame);
+requestDraw();
