@@ -18,6 +18,7 @@ from __future__ import annotations
 import math
 
 from roverlab.description.errors import DescriptionError
+from roverlab.description.gazebo import REFERENCE_KEYS
 from roverlab.description.gazebo_specs import (
     CameraPluginSpec,
     DiffDriveSpec,
@@ -33,20 +34,10 @@ from roverlab.description.model import Mesh, RobotModel
 
 __all__ = ["format_check", "format_tree", "robot_notes", "robot_warnings"]
 
-# <gazebo reference> settings (URDF tag -> GazeboReference field) that the 2D simulator
-# reads nowhere: its drive is kinematic (wheel slip is the gazebo node's wheel_slip) and a
-# contact stops the body, so ODE's friction and contact parameters have nothing to act on.
-_CONTACT_SETTINGS = {
-    "mu1": "mu1",
-    "mu2": "mu2",
-    "kp": "kp",
-    "kd": "kd",
-    "minDepth": "min_depth",
-    "maxVel": "max_vel",
-    "fdir1": "fdir1",
-    "selfCollide": "self_collide",
-    "gravity": "gravity",
-}
+# <gazebo reference> settings that the 2D simulator reads nowhere: its drive is kinematic
+# (wheel slip is the gazebo node's wheel_slip) and a contact stops the body, so ODE's
+# friction and contact parameters have nothing to act on. Only the material is used.
+_CONTACT_SETTINGS = {tag: attr for tag, attr in REFERENCE_KEYS.items() if tag != "material"}
 
 
 def robot_warnings(model: RobotModel) -> list[str]:

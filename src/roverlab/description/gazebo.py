@@ -53,7 +53,7 @@ from roverlab.description.gazebo_specs import (
 )
 from roverlab.geometry import Transform3, quat_from_rpy
 
-__all__ = ["PLUGIN_SPECS", "parse_gazebo"]
+__all__ = ["PLUGIN_SPECS", "REFERENCE_KEYS", "parse_gazebo"]
 
 
 # --------------------------------------------------------------------------- parsing
@@ -515,7 +515,8 @@ def _sensor(elem: ET.Element, link: str, where: str, model_name: str) -> GazeboS
     )
 
 
-_REFERENCE_KEYS: Final = {
+# <gazebo reference> elements read into GazeboReference (URDF tag -> field)
+REFERENCE_KEYS: Final = {
     "material": "material",
     "mu1": "mu1",
     "mu2": "mu2",
@@ -547,7 +548,7 @@ def _reference(name: str, values: dict[str, str], where: str) -> GazeboReference
         fdir1=v.vector("fdir1", (0.0, 0.0, 0.0)) if "fdir1" in values else None,
         self_collide=v.flag("selfCollide", False) if "selfCollide" in values else None,
         gravity=v.flag("gravity", True) if "gravity" in values else None,
-        params=MappingProxyType({k: t for k, t in values.items() if k not in _REFERENCE_KEYS}),
+        params=MappingProxyType({k: t for k, t in values.items() if k not in REFERENCE_KEYS}),
     )
 
 
