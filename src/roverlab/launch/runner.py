@@ -16,7 +16,13 @@ from roverlab.core.executor import ClockMode
 from roverlab.core.log import log_to_file
 from roverlab.core.transport.zenoh import ZenohTransport
 from roverlab.description.check import robot_notes, robot_warnings
-from roverlab.launch.process import ScriptProcess, ScriptProcesses, find_script, is_python_script
+from roverlab.launch.process import (
+    ScriptProcess,
+    ScriptProcesses,
+    child_network,
+    find_script,
+    is_python_script,
+)
 from roverlab.launch.registry import REGISTRY, LaunchState
 from roverlab.launch.xml import LaunchError, LaunchSpec, NodeSpec, load_launch
 from roverlab.msgs import classes as mc
@@ -120,7 +126,8 @@ class Launch:
                 "not compiled nodes); skipped"
             )
             return
-        if not any(isinstance(t, ZenohTransport) for t in self.context.transports):
+        zenoh = [t for t in self.context.transports if isinstance(t, ZenohTransport)]
+        if not zenoh:
             raise LaunchError(
                 f"{what}: the script runs in a process of its own, which needs the launch's "
                 "topics exposed (--expose)"
@@ -129,7 +136,13 @@ class Launch:
             self._group = ScriptProcesses()
             self.context.add_transport(self._group)  # stopped when the context shuts down
         clock = "wall" if self.context.clock_mode is ClockMode.WALL else "external"
-        proc = ScriptProcess(node_spec, script, clock=clock, params=self.spec.params)
+        proc = ScriptProcess(
+            node_spec,
+            script,
+            clock=clock,
+            params=self.spec.params,
+            network=child_network(zenoh[0].options),
+        )
         self._group.processes.append(proc)
         self.processes[node_spec.fq_name] = (node_spec, proc)
 
