@@ -23,7 +23,7 @@ from roverlab.cli.sim import parse_rate
 from roverlab.core import Context, configure_logging
 from roverlab.description import find_package
 from roverlab.launch import REGISTRY, LaunchError, LaunchSpec, build_launch, load_launch
-from roverlab.launch.process import find_script, launch_endpoint
+from roverlab.launch.process import find_scripts, launch_endpoint
 
 CLOCKS = ("auto", "sim", "external", "wall")
 _SIMULATOR_NODES = {("gazebo_ros", "gzserver"), ("gazebo_ros", "spawn_model")}
@@ -153,7 +153,7 @@ def launch(
     if note:
         typer.echo(f"note: {note}", err=True)
     # the topics are exposed first: script nodes run in processes of their own
-    scripts = [n for n in spec.nodes if (n.pkg, n.type) not in REGISTRY and find_script(n)]
+    scripts = [n for n in spec.nodes if (n.pkg, n.type) not in REGISTRY and find_scripts(n)]
     if scripts and expose is None:
         expose = True  # --rate max too: the scripts must hear the launch
     context = Context(clock=mode, rate=1.0 if math.isinf(pace) else pace)
@@ -168,7 +168,7 @@ def launch(
             report_warnings(f"launch {path.name}", started.warnings, strict)
             report_warnings("Gazebo world", started.world_warnings, strict)
             report_warnings("spawned robot", started.robot_warnings, strict)
-            report_notes(started.robot_notes)
+            report_notes(started.notes + started.robot_notes)
         names = ", ".join(n.get_fully_qualified_name() for n in started.nodes)
         typer.echo(f"started {len(started.nodes)} nodes: {names}", err=True)
         for name, (_, proc) in started.processes.items():

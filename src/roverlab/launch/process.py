@@ -35,7 +35,7 @@ __all__ = [
     "ScriptProcess",
     "ScriptProcesses",
     "child_network",
-    "find_script",
+    "find_scripts",
     "is_python_script",
     "launch_endpoint",
     "ros_home",
@@ -46,17 +46,17 @@ _TIMEOUT_SIGINT_S = 15.0
 _TIMEOUT_SIGTERM_S = 2.0
 
 
-def find_script(spec: NodeSpec, package_path: tuple[str, ...] = ()) -> Path | None:
-    """The file ``spec.type`` in package ``spec.pkg`` (searched through the package's
-    folders, as roslaunch finds a node's executable), or ``None``."""
+def find_scripts(spec: NodeSpec, package_path: tuple[str, ...] = ()) -> list[Path]:
+    """The files named ``spec.type`` in package ``spec.pkg`` (searched through the
+    package's folders, as roslaunch finds a node's executable): one to run; none, or
+    several (roslaunch's "multiple files named"), to report."""
     try:
         folder = find_package(spec.pkg, package_path)
     except DescriptionError:
-        return None
+        return []
     if "/" in spec.type or not spec.type:
-        return None
-    matches = sorted(p for p in folder.rglob(spec.type) if p.is_file())
-    return matches[0] if matches else None
+        return []
+    return sorted(p for p in folder.rglob(spec.type) if p.is_file())
 
 
 def is_python_script(path: Path) -> bool:

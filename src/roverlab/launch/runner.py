@@ -20,7 +20,7 @@ from roverlab.launch.process import (
     ScriptProcess,
     ScriptProcesses,
     child_network,
-    find_script,
+    find_scripts,
     is_python_script,
 )
 from roverlab.launch.registry import REGISTRY, LaunchState
@@ -62,6 +62,7 @@ class Launch:
     # what roslaunch does for a process: which node runs each <node>, and how it ended
     running: dict[str, tuple[NodeSpec, Node]] = field(default_factory=dict)
     deaths: list[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)  # where roverlab does what roslaunch won't
     # the user's own scripts, each in a process of its own (roverlab run), by node name
     processes: dict[str, tuple[NodeSpec, ScriptProcess]] = field(default_factory=dict)
     _group: ScriptProcesses | None = None
@@ -76,6 +77,12 @@ class Launch:
         if factory is None:
             self.start_script(node_spec)
             return None
+        if node_spec.cwd is not None:
+            self.state.warnings.append(
+                f"{node_spec.source}: cwd={node_spec.cwd!r} not applied: roverlab's "
+                f"{node_spec.pkg}/{node_spec.type} runs in the launch's process, so relative "
+                f"paths resolve against its working directory ({os.getcwd()})"
+            )
         if node_spec.launch_prefix:
             self.state.warnings.append(
                 f"{node_spec.source}: launch-prefix={node_spec.launch_prefix!r} not applied: "
@@ -113,19 +120,31 @@ class Launch:
         process of its own (as ``roverlab run``), else skipped with a warning."""
         assert self.state is not None
         what = f"{node_spec.source}: node {node_spec.pkg}/{node_spec.type}"
-        script = find_script(node_spec)
-        if script is None:
+        found = find_scripts(node_spec)
+        if not found:
             self.state.warnings.append(
                 f"{what} is not part of roverlab and package {node_spec.pkg} has no "
                 f"script {node_spec.type!r}; skipped"
             )
             return
+        if len(found) > 1:  # roslaunch cannot choose either
+            self.state.warnings.append(
+                f"{what}: multiple files named [{node_spec.type}] in package "
+                f"[{node_spec.pkg}]: {', '.join(str(p) for p in found)}; skipped"
+            )
+            return
+        script = found[0]
         if not is_python_script(script):
             self.state.warnings.append(
                 f"{what}: {script} is not a Python script (roverlab runs rospy scripts, "
                 "not compiled nodes); skipped"
             )
             return
+        if not os.access(script, os.X_OK):  # roslaunch: "found but it is not executable"
+            self.notes.append(
+                f"{what}: {script} is not executable (roslaunch refuses it; chmod +x "
+                "it for ROS): run anyway"
+            )
         zenoh = [t for t in self.context.transports if isinstance(t, ZenohTransport)]
         if not zenoh:
             raise LaunchError(
