@@ -157,3 +157,30 @@ def test_scripts_that_cannot_run_are_named(
             build_launch(path, context=private)
     finally:
         private.shutdown()
+
+
+def test_an_ambiguous_script_is_refused_and_a_non_executable_one_noted(
+    tmp_path: Path, daemon: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    path = _package(tmp_path, """<launch>
+  <node pkg="my_pkg" type="talker.py" name="talker"/>
+  <node pkg="my_pkg" type="once.py" name="once"/>
+</launch>""")  # fmt: skip
+    scripts = path.parents[1] / "scripts"
+    (path.parents[1] / "nodes").mkdir()
+    (path.parents[1] / "nodes" / "talker.py").write_text(SCRIPT)  # a second talker.py
+    (scripts / "once.py").write_text("print('once')\n")  # mode 0644: forgot chmod +x
+    monkeypatch.setenv("ROS_PACKAGE_PATH", str(path.parents[2]))
+    monkeypatch.setenv("ROS_HOME", str(tmp_path / "ros_home"))
+    ctx = _context()
+    try:
+        launch = build_launch(path, context=ctx)
+    finally:
+        ctx.shutdown()
+    (ambiguous,) = launch.warnings
+    assert ambiguous.startswith(f'{path}: <node name="talker">: node my_pkg/talker.py: ')
+    assert "multiple files named [talker.py] in package [my_pkg]" in ambiguous
+    assert list(launch.processes) == ["/once"]
+    (note,) = launch.notes
+    assert f"{scripts / 'once.py'} is not executable (roslaunch refuses it" in note
+    assert note.startswith(f"{path}: ") and note.endswith("run anyway")

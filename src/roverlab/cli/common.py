@@ -78,6 +78,9 @@ class NetworkOptions:
     tls_key: str | None = None
     multicast: bool = False
     insecure: bool = False
+    client_of: str | None = None
+    """A launch's script process: a Zenoh client of the launch's own endpoint (it then
+    sees and is seen by exactly what the launch is joined to, however that joined)."""
 
     def zenoh_options(self) -> ZenohOptions:
         """The transport settings; an explicit ``--connect`` fails fast (5 s) with a clear
@@ -87,6 +90,15 @@ class NetworkOptions:
             RoverlabError: a non-loopback ``--listen`` without ``--user``/``--password``
                 and without ``--insecure``.
         """
+        if self.client_of is not None:
+            return ZenohOptions(
+                mode="client",
+                listen=(),
+                connect=(self.client_of,),
+                user=self.user,
+                password=self.password,
+                connect_timeout_s=_CONNECT_TIMEOUT_S,
+            )
         exposed = [ep for ep in self.listen if not is_loopback_endpoint(ep)]
         if exposed and self.user is None and not self.insecure:
             raise RoverlabError(
@@ -252,11 +264,21 @@ def choose_expose(expose: bool | None, pace: float) -> bool:
     return True
 
 
-def expose_if_asked(ctx: typer.Context, context: Context, expose: bool | None, pace: float) -> None:
+def expose_if_asked(
+    ctx: typer.Context,
+    context: Context,
+    expose: bool | None,
+    pace: float,
+    *,
+    also_listen: tuple[str, ...] = (),
+) -> None:
     """Attach ``context`` to the network (Zenoh, the command's network options) when
-    :func:`choose_expose` says so."""
+    :func:`choose_expose` says so, listening on ``also_listen`` too (the endpoint a
+    launch's script processes join it by)."""
     if choose_expose(expose, pace):
-        context.add_transport(ZenohTransport(network_options(ctx).zenoh_options()))
+        options = network_options(ctx)
+        options = replace(options, listen=(*options.listen, *also_listen))
+        context.add_transport(ZenohTransport(options.zenoh_options()))
 
 
 class StartGuard:

@@ -2,7 +2,11 @@
 
 from __future__ import annotations
 
+import contextlib
 import math
+import shutil
+import tempfile
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Annotated
 
@@ -19,7 +23,7 @@ from roverlab.cli.sim import parse_rate
 from roverlab.core import Context, configure_logging
 from roverlab.description import find_package
 from roverlab.launch import REGISTRY, LaunchError, LaunchSpec, build_launch, load_launch
-from roverlab.launch.process import find_script
+from roverlab.launch.process import find_scripts, launch_endpoint
 
 CLOCKS = ("auto", "sim", "external", "wall")
 _SIMULATOR_NODES = {("gazebo_ros", "gzserver"), ("gazebo_ros", "spawn_model")}
@@ -63,6 +67,20 @@ def choose_clock(spec: LaunchSpec, clock: str, pace: float) -> tuple[str, str]:
         "no simulator in this launch: following /clock from another process "
         "(start `roverlab sim` elsewhere, or pass --clock wall)"
     )
+
+
+@contextlib.contextmanager
+def _script_endpoint(needed: bool) -> Iterator[tuple[str, ...]]:
+    """The endpoint the launch's script processes join it by (a Unix socket in a private
+    temporary folder, removed at the end), when it has script nodes."""
+    if not needed:
+        yield ()
+        return
+    folder = Path(tempfile.mkdtemp(prefix="roverlab-launch-"))
+    try:
+        yield (launch_endpoint(folder),)
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
 
 
 def _resolve(target: list[str]) -> tuple[Path, dict[str, str]]:
@@ -134,27 +152,28 @@ def launch(
     mode, note = choose_clock(spec, clock, pace)
     if note:
         typer.echo(f"note: {note}", err=True)
+    # the topics are exposed first: script nodes run in processes of their own
+    scripts = [n for n in spec.nodes if (n.pkg, n.type) not in REGISTRY and find_scripts(n)]
+    if scripts and expose is None:
+        expose = True  # --rate max too: the scripts must hear the launch
     context = Context(clock=mode, rate=1.0 if math.isinf(pace) else pace)
     guard = StartGuard(context)
-    with guard:
-        if record is not None:
-            guard.record(record)
-        # the topics are exposed first: script nodes run in processes of their own
-        scripts = [n for n in spec.nodes if (n.pkg, n.type) not in REGISTRY and find_script(n)]
-        if scripts and expose is None:
-            expose = True  # --rate max too: the scripts must hear the launch
-        expose_if_asked(ctx, context, expose, pace)
-        started = build_launch(spec, context=context, seed=seed)
-    with guard:
-        report_warnings(f"launch {path.name}", started.warnings, strict)
-        report_warnings("Gazebo world", started.world_warnings, strict)
-        report_warnings("spawned robot", started.robot_warnings, strict)
-        report_notes(started.notes)
-    names = ", ".join(n.get_fully_qualified_name() for n in started.nodes)
-    typer.echo(f"started {len(started.nodes)} nodes: {names}", err=True)
-    for name, (_, proc) in started.processes.items():
-        typer.echo(f"started process [{name}] (pid {proc.pid}): {proc.script}", err=True)
-    started.supervise()
-    wall = run_context(context, duration)
+    with _script_endpoint(bool(scripts)) as also_listen:
+        with guard:
+            if record is not None:
+                guard.record(record)
+            expose_if_asked(ctx, context, expose, pace, also_listen=also_listen)
+            started = build_launch(spec, context=context, seed=seed)
+        with guard:
+            report_warnings(f"launch {path.name}", started.warnings, strict)
+            report_warnings("Gazebo world", started.world_warnings, strict)
+            report_warnings("spawned robot", started.robot_warnings, strict)
+            report_notes(started.notes)
+        names = ", ".join(n.get_fully_qualified_name() for n in started.nodes)
+        typer.echo(f"started {len(started.nodes)} nodes: {names}", err=True)
+        for name, (_, proc) in started.processes.items():
+            typer.echo(f"started process [{name}] (pid {proc.pid}): {proc.script}", err=True)
+        started.supervise()
+        wall = run_context(context, duration)
     ran = "" if mode == "wall" else f"{context.now().seconds:.1f} sim s, "
     typer.echo(f"launch stopped after {ran}{wall:.1f} s wall", err=True)

@@ -134,6 +134,15 @@ def root(
             "network only: anyone on it can read and drive the robot).",
         ),
     ] = False,
+    client_of: Annotated[
+        str | None,
+        typer.Option(
+            "--client-of",
+            hidden=True,
+            help="Join as a Zenoh client of this endpoint only (a launch's script nodes: "
+            "they join the launch's graph through the launch).",
+        ),
+    ] = None,
 ) -> None:
     """roverlab: simulate, map, localise, navigate and inspect robots the ROS way."""
     ctx.obj = NetworkOptions(
@@ -146,6 +155,7 @@ def root(
         tls_key=tls_key,
         multicast=multicast,
         insecure=insecure,
+        client_of=client_of,
     )
 
 

@@ -1,5 +1,6 @@
-"""``<param command="...">``: xacro in-process (ROS 1's spellings), other commands in a
-shell."""
+"""``<param command="...">``: xacro in-process (ROS 1's spellings), other commands as
+roslaunch runs them: split with :func:`shlex.split` and run without a shell (``$VAR``,
+pipes, ``;`` and ``>`` are not interpreted)."""
 
 from __future__ import annotations
 
@@ -16,7 +17,8 @@ __all__ = ["command_value", "xacro_argv"]
 
 def command_value(command: str, where: str, package_path: tuple[str, ...] = ()) -> str:
     """The output of ``command`` (``where`` names the file and element in errors): xacro
-    runs in-process (roverlab's hooked xacro); others in a shell.
+    runs in-process (roverlab's hooked xacro); others as roslaunch runs them, split with
+    ``shlex`` and without a shell.
 
     Raises:
         LaunchError: the command cannot be parsed, is not found or exits non-zero.
@@ -24,17 +26,20 @@ def command_value(command: str, where: str, package_path: tuple[str, ...] = ()) 
     try:
         argv = shlex.split(command)
     except ValueError as err:
-        raise LaunchError(f"{where}: cannot parse command: {err}") from err
+        raise LaunchError(f"{where}: cannot parse command {command!r}: {err}") from err
+    if not argv:
+        raise LaunchError(f"{where}: empty command")
     xacro = xacro_argv(argv)
     if xacro is not None:
         return _xacro(xacro, where, package_path)
     try:
-        done = subprocess.run(command, shell=True, capture_output=True, text=True, check=False)
+        done = subprocess.run(argv, capture_output=True, text=True, check=False)
     except OSError as err:
-        raise LaunchError(f"{where}: command failed: {err}") from err
+        what = "no such command" if isinstance(err, FileNotFoundError) else err.strerror
+        raise LaunchError(f"{where}: command {command!r}: {argv[0]}: {what}") from err
     if done.returncode != 0:
         first = (done.stderr.strip().splitlines() or ["no output"])[0]
-        raise LaunchError(f"{where}: command exited {done.returncode}: {first}")
+        raise LaunchError(f"{where}: command {command!r} exited {done.returncode}: {first}")
     return done.stdout
 
 

@@ -3,8 +3,9 @@
 roslaunch starts every node as a process. roverlab's own nodes run inside the launch's
 process; a Python script of the user's package (``<node pkg="my_pkg" type="talker.py">``)
 runs as roslaunch runs it, in a child process (``roverlab run SCRIPT``) joined to the
-launch through the local daemon, with the ``<node>``'s arguments, remappings, name,
-namespace, ``<env>``, ``cwd`` and ``launch-prefix``. Its private parameters and the
+launch's graph (a Zenoh client of the launch's own endpoint: :func:`child_network`),
+with the ``<node>``'s arguments, remappings, name, namespace, ``<env>``, ``cwd`` and
+``launch-prefix``. Its private parameters and the
 launch's global ones reach rospy's ``get_param`` through a YAML file named by
 ``ROVERLAB_LAUNCH_PARAMS`` (ROS 1's parameter server, for that one process).
 """
@@ -17,34 +18,45 @@ import signal
 import subprocess
 import sys
 import tempfile
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, Any
 
 import yaml
 
+from roverlab.core.transport.zenoh import ZenohOptions, daemon_endpoint
 from roverlab.description import find_package
 from roverlab.description.errors import DescriptionError
 from roverlab.launch.xml import LaunchError, NodeSpec
 from roverlab.ros1.rospy.runtime import LAUNCH_PARAMS_ENV
 
-__all__ = ["ScriptProcess", "ScriptProcesses", "find_script", "is_python_script", "ros_home"]
+__all__ = [
+    "ChildNetwork",
+    "ScriptProcess",
+    "ScriptProcesses",
+    "child_network",
+    "find_scripts",
+    "is_python_script",
+    "launch_endpoint",
+    "ros_home",
+]
 
 # roslaunch's escalation when it stops a process: SIGINT, then SIGTERM, then SIGKILL
 _TIMEOUT_SIGINT_S = 15.0
 _TIMEOUT_SIGTERM_S = 2.0
 
 
-def find_script(spec: NodeSpec, package_path: tuple[str, ...] = ()) -> Path | None:
-    """The file ``spec.type`` in package ``spec.pkg`` (searched through the package's
-    folders, as roslaunch finds a node's executable), or ``None``."""
+def find_scripts(spec: NodeSpec, package_path: tuple[str, ...] = ()) -> list[Path]:
+    """The files named ``spec.type`` in package ``spec.pkg`` (searched through the
+    package's folders, as roslaunch finds a node's executable): one to run; none, or
+    several (roslaunch's "multiple files named"), to report."""
     try:
         folder = find_package(spec.pkg, package_path)
     except DescriptionError:
-        return None
+        return []
     if "/" in spec.type or not spec.type:
-        return None
-    matches = sorted(p for p in folder.rglob(spec.type) if p.is_file())
-    return matches[0] if matches else None
+        return []
+    return sorted(p for p in folder.rglob(spec.type) if p.is_file())
 
 
 def is_python_script(path: Path) -> bool:
@@ -57,6 +69,59 @@ def is_python_script(path: Path) -> bool:
     except OSError:
         return False
     return first.startswith(b"#!") and b"python" in first
+
+
+def launch_endpoint(folder: Path) -> str:
+    """A Unix-socket endpoint in ``folder`` (a private temporary folder) for the launch to
+    listen on, so that its script processes join it there (no port to pick, and only this
+    user can connect)."""
+    return f"unixsock-stream/{folder / 'zenoh.sock'}"
+
+
+@dataclass(frozen=True)
+class ChildNetwork:
+    """How a script process joins the launch's graph: root options of ``roverlab`` (never
+    a password) and environment variables (``None``: removed)."""
+
+    args: tuple[str, ...] = ()
+    env: dict[str, str | None] = field(default_factory=dict)
+
+
+def _joinable(endpoint: str) -> bool:
+    """A Unix socket, or a loopback TCP port fixed in advance (not ``:0``)."""
+    proto, _, addr = endpoint.partition("/")
+    if proto.startswith("unixsock"):
+        return True
+    host, _, port = addr.split("#")[0].rpartition(":")
+    return proto == "tcp" and host.startswith("127.") and port not in ("", "0")
+
+
+def child_network(options: ZenohOptions) -> ChildNetwork:
+    """The same graph as a launch joined with ``options``: a Zenoh client of the launch's
+    Unix socket (or fixed loopback port), which routes for it, so it is seen wherever the
+    launch is (the robot's daemon, a laptop connected to the launch, the robot the launch
+    connected to, multicast peers). Without such an endpoint: a peer with the launch's
+    ``connect`` endpoints, credentials and TLS CA. The password and the domain go in the
+    environment (``ps`` shows a command line)."""
+    secret = {
+        "ROVERLAB_PASSWORD": options.password,
+        "ROVERLAB_DOMAIN_ID": str(options.domain),
+        "ROVERLAB_CONNECT": None,  # the launch's own, given explicitly below
+        "ROVERLAB_LISTEN": None,
+    }
+    user = ("--user", options.user) if options.user is not None else ()
+    own = [ep for ep in options.listen if _joinable(ep)]
+    if own:
+        return ChildNetwork(args=("--client-of", own[0], *user), env=secret)
+    args: list[str] = list(user)
+    if options.connect != (daemon_endpoint(),) or options.present_credentials:
+        for ep in options.connect:
+            args += ["--connect", ep]
+    if options.tls_root_ca is not None:
+        args += ["--tls-root-ca", options.tls_root_ca]
+    if options.multicast_scouting:
+        args.append("--multicast")
+    return ChildNetwork(args=tuple(args), env=secret)
 
 
 def ros_home() -> Path:
@@ -74,18 +139,33 @@ class ScriptProcess:
         script: the script file.
         clock: ``roverlab run --clock`` (``wall`` or ``external``: the launch's clock).
         params: the launch's global parameters (absolute names).
+        network: how it joins the launch's graph (:func:`child_network`).
     """
 
-    def __init__(self, spec: NodeSpec, script: Path, *, clock: str, params: dict[str, Any]) -> None:
+    def __init__(
+        self,
+        spec: NodeSpec,
+        script: Path,
+        *,
+        clock: str,
+        params: dict[str, Any],
+        network: ChildNetwork,
+    ) -> None:
         self.spec = spec
         self.script = script
         self._params_file = _write_params(spec, params)
-        argv = [*shlex.split(spec.launch_prefix), sys.executable, "-m", "roverlab.cli", "run"]
+        argv = [*shlex.split(spec.launch_prefix), sys.executable, "-m", "roverlab.cli"]
+        argv += [*network.args, "run"]
         argv += ["--clock", clock, str(script), *shlex.split(spec.args)]
         argv += [f"{k}:={v}" for k, v in spec.remaps.items()]
         argv += [f"__name:={spec.name}", f"__ns:={spec.namespace}"]
         self.argv = argv
         env = {**os.environ, **spec.env, LAUNCH_PARAMS_ENV: self._params_file}
+        for key, value in network.env.items():  # the launch's graph, whatever <env> says
+            if value is None:
+                env.pop(key, None)
+            else:
+                env[key] = value
         env["PYTHONUNBUFFERED"] = "1"  # its lines in order with the launch's
         cwd = script.parent if spec.cwd == "node" else ros_home()
         self._log: IO[bytes] | None = None

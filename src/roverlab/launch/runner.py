@@ -16,7 +16,13 @@ from roverlab.core.executor import ClockMode
 from roverlab.core.log import log_to_file
 from roverlab.core.transport.zenoh import ZenohTransport
 from roverlab.description.check import robot_notes, robot_warnings
-from roverlab.launch.process import ScriptProcess, ScriptProcesses, find_script, is_python_script
+from roverlab.launch.process import (
+    ScriptProcess,
+    ScriptProcesses,
+    child_network,
+    find_scripts,
+    is_python_script,
+)
 from roverlab.launch.registry import REGISTRY, LaunchState
 from roverlab.launch.xml import LaunchError, LaunchSpec, NodeSpec, load_launch
 from roverlab.msgs import classes as mc
@@ -56,6 +62,9 @@ class Launch:
     # what roslaunch does for a process: which node runs each <node>, and how it ended
     running: dict[str, tuple[NodeSpec, Node]] = field(default_factory=dict)
     deaths: list[str] = field(default_factory=list)
+    # notes, not warnings: where roverlab does what roslaunch won't, and what the world and
+    # the spawned robot say that the simulator does not act on (non-static models, contacts)
+    notes: list[str] = field(default_factory=list)
     # the user's own scripts, each in a process of its own (roverlab run), by node name
     processes: dict[str, tuple[NodeSpec, ScriptProcess]] = field(default_factory=dict)
     _group: ScriptProcesses | None = None
@@ -70,6 +79,12 @@ class Launch:
         if factory is None:
             self.start_script(node_spec)
             return None
+        if node_spec.cwd is not None:
+            self.state.warnings.append(
+                f"{node_spec.source}: cwd={node_spec.cwd!r} not applied: roverlab's "
+                f"{node_spec.pkg}/{node_spec.type} runs in the launch's process, so relative "
+                f"paths resolve against its working directory ({os.getcwd()})"
+            )
         if node_spec.launch_prefix:
             self.state.warnings.append(
                 f"{node_spec.source}: launch-prefix={node_spec.launch_prefix!r} not applied: "
@@ -107,20 +122,33 @@ class Launch:
         process of its own (as ``roverlab run``), else skipped with a warning."""
         assert self.state is not None
         what = f"{node_spec.source}: node {node_spec.pkg}/{node_spec.type}"
-        script = find_script(node_spec)
-        if script is None:
+        found = find_scripts(node_spec)
+        if not found:
             self.state.warnings.append(
                 f"{what} is not part of roverlab and package {node_spec.pkg} has no "
                 f"script {node_spec.type!r}; skipped"
             )
             return
+        if len(found) > 1:  # roslaunch cannot choose either
+            self.state.warnings.append(
+                f"{what}: multiple files named [{node_spec.type}] in package "
+                f"[{node_spec.pkg}]: {', '.join(str(p) for p in found)}; skipped"
+            )
+            return
+        script = found[0]
         if not is_python_script(script):
             self.state.warnings.append(
                 f"{what}: {script} is not a Python script (roverlab runs rospy scripts, "
                 "not compiled nodes); skipped"
             )
             return
-        if not any(isinstance(t, ZenohTransport) for t in self.context.transports):
+        if not os.access(script, os.X_OK):  # roslaunch: "found but it is not executable"
+            self.notes.append(
+                f"{what}: {script} is not executable (roslaunch refuses it; chmod +x "
+                "it for ROS): run anyway"
+            )
+        zenoh = [t for t in self.context.transports if isinstance(t, ZenohTransport)]
+        if not zenoh:
             raise LaunchError(
                 f"{what}: the script runs in a process of its own, which needs the launch's "
                 "topics exposed (--expose)"
@@ -129,7 +157,13 @@ class Launch:
             self._group = ScriptProcesses()
             self.context.add_transport(self._group)  # stopped when the context shuts down
         clock = "wall" if self.context.clock_mode is ClockMode.WALL else "external"
-        proc = ScriptProcess(node_spec, script, clock=clock, params=self.spec.params)
+        proc = ScriptProcess(
+            node_spec,
+            script,
+            clock=clock,
+            params=self.spec.params,
+            network=child_network(zenoh[0].options),
+        )
         self._group.processes.append(proc)
         self.processes[node_spec.fq_name] = (node_spec, proc)
 
@@ -203,9 +237,6 @@ class Launch:
     """The Gazebo world's warnings, grouped (models and meshes not found, ...)."""
     robot_warnings: list[str] = field(default_factory=list)
     """The spawned robot's warnings (urdfdom's, unsupported plugins and sensors)."""
-    notes: list[str] = field(default_factory=list)
-    """What the world and the spawned robot say that the simulator does not act on
-    (non-static models, links' contact settings): notes, not warnings."""
 
 
 def build_launch(

@@ -27,7 +27,7 @@ class NodeSpec:
     required: bool = False
     env: dict[str, str] = field(default_factory=dict)  # <env> of its scope
     clear_params: bool = False
-    cwd: str = "ROS_HOME"  # a script node's working directory: ROS_HOME or node
+    cwd: str | None = None  # a script node's working directory: ROS_HOME (None) or node
     launch_prefix: str = ""  # put before a script node's command (xterm -e, nice, ...)
 
     @property

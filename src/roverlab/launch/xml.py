@@ -431,8 +431,8 @@ class _Reader:
             raise LaunchError(f"{where}: respawn_delay must be a number, not {delay!r}") from None
         if not (node.respawn_delay >= 0.0 and node.respawn_delay < float("inf")):
             raise LaunchError(f"{where}: respawn_delay must be >= 0 seconds, not {delay}")
-        node.cwd = self.attr(elem, "cwd", scope, "ROS_HOME")
-        if node.cwd not in ("ROS_HOME", "node"):
+        node.cwd = self.attr(elem, "cwd", scope) if "cwd" in elem.attrib else None
+        if node.cwd not in (None, "ROS_HOME", "node"):
             raise LaunchError(f"{where}: cwd must be 'ROS_HOME' or 'node', not {node.cwd!r}")
         node.launch_prefix = self.attr(elem, "launch-prefix", scope, "")
 
@@ -580,7 +580,11 @@ def load_launch(
     p = Path(path)
     if not p.is_file():
         raise LaunchError(f"{p}: no such launch file")
-    reader.read_file(p, dict(args or {}))
+    top = reader.read_file(p, dict(args or {}))
+    for name in sorted(set(args or {}) - top.declared):  # roslaunch takes them silently
+        reader.spec.warnings.append(
+            f'{p}: {name}:= on the command line, but the file declares no <arg name="{name}">'
+        )
     return reader.spec
 
 
