@@ -251,3 +251,11 @@ def test_planar_move_bad_values_are_one_clear_error() -> None:
         load_robot(_planar("<publishOdometryTf>maybe</publishOdometryTf>"))
     with pytest.raises(DescriptionError, match=r"planar move robotBaseFrame 'chassis' is not"):
         sim_config_from_model(load_robot(_planar("<robotBaseFrame>chassis</robotBaseFrame>")))
+
+
+def test_a_second_drive_plugin_is_warned() -> None:
+    second = '<gazebo><plugin name="b" filename="libgazebo_ros_planar_move.so"/></gazebo>'
+    m = load_robot(_planar("").replace("</robot>", second + "</robot>"))
+    assert len(m.gazebo.plugins) == 2
+    (w,) = [w for w in robot_warnings(m) if "drive plugins" in w]
+    assert "2 drive plugins: the first (libgazebo_ros_planar_move.so) moves the robot" in w

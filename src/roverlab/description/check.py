@@ -112,8 +112,16 @@ def robot_notes(model: RobotModel, *, detail: bool = False) -> list[str]:
 
 
 def _drive_warnings(model: RobotModel) -> list[str]:
-    """gazebo_ros_diff_drive settings the simulator's kinematic drive does not act on."""
+    """gazebo_ros_diff_drive settings the simulator's kinematic drive does not act on, and
+    drive plugins beyond the first (Gazebo would run them all, fighting over the body)."""
     out: list[str] = []
+    drives = [p for p in model.gazebo.plugins if isinstance(p.spec, DiffDriveSpec | PlanarMoveSpec)]
+    if len(drives) > 1:
+        out.append(
+            f"{model.source}: {len(drives)} drive plugins: the first "
+            f"({drives[0].filename}) moves the robot; not simulated: "
+            + ", ".join(p.filename for p in drives[1:])
+        )
     for plugin in model.gazebo.plugins:
         spec = plugin.spec
         if not isinstance(spec, DiffDriveSpec):
