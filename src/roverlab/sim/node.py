@@ -2,8 +2,8 @@
 
 Thin: it wires :mod:`roverlab.sim.diff_drive`, :mod:`roverlab.sim.planar_move`,
 :mod:`roverlab.sim.collision` and :mod:`roverlab.sim.sensors` to topics, TF and
-parameters. Every random draw comes from a
-generator spawned from the ``seed`` parameter, so a seeded run is reproducible.
+parameters. Every random draw comes from a generator spawned from the ``seed``
+parameter, so a seeded run is reproducible.
 """
 
 from __future__ import annotations
@@ -157,9 +157,9 @@ class SimulatorNode(Node):
             )
         # drive
         self.drive = robot.drive
-        dd = self.drive if isinstance(self.drive, DiffDriveConfig) else None
+        d = self.drive if isinstance(self.drive, DiffDriveConfig) else None
         # the node's wheel_slip parameter sets the drive's slip (DiffDriveParams validates)
-        p = replace(dd.params if dd else DiffDriveParams(1.0, 1.0), slip_stddev=self.wheel_slip)
+        p = replace(d.params if d else DiffDriveParams(1.0, 1.0), slip_stddev=self.wheel_slip)
         self._params = np.array(
             [
                 p.wheel_separation_m,
@@ -186,7 +186,7 @@ class SimulatorNode(Node):
         self._advance = compiled_entry(advance_packed, self._pack, self._near, 0, 0)
         self.tf = TransformBroadcaster(self)
         self._tf_pub = self.tf.publisher
-        self._wheel_k = 2.0 / dd.params.wheel_diameter_m if dd else 0.0
+        self._wheel_k = 2.0 / d.params.wheel_diameter_m if d else 0.0
         self._mounts: dict[int, tuple[float, float, float, float, float]] = {}
         self.planar_move = None
         if isinstance(self.drive, PlanarMoveConfig):
@@ -194,8 +194,7 @@ class SimulatorNode(Node):
                 node=self, config=self.drive, state=self._state, advance=self.advance,
                 tf_publisher=self._tf_pub,
             )  # fmt: skip
-        if dd is not None:
-            d = dd
+        if d is not None:
             self.create_subscription(mc.Twist, d.command_topic, self._on_cmd, 10)
             self.odom_pub = self.create_publisher(mc.Odometry, d.odometry_topic, 10)
             self.joint_pub = (
