@@ -18,6 +18,7 @@ from roverlab.sim.app import Simulation
 from roverlab.sim.collision import circle_polygon, inner_radius
 from roverlab.sim.dynamics import (
     DRIVE_HOLONOMIC,
+    S_CONTACT,
     S_CVX,
     S_CVY,
     S_CW,
@@ -26,7 +27,9 @@ from roverlab.sim.dynamics import (
     S_X,
     S_Y,
     STATE_SIZE,
+    PhysicsPack,
     advance,
+    advance_packed,
 )
 from roverlab.sim.node import SpawnPose
 from roverlab.world.yaml_world import world_from_dict
@@ -238,3 +241,19 @@ def test_the_kernel_glides_and_stops_at_a_wall_without_noise() -> None:
     stop = 0.5 - 0.15 / math.cos(math.pi / 24)
     assert state[S_Y] == pytest.approx(stop, abs=1e-4) and state[S_Y] <= stop
     assert (state[S_X], state[S_TH], state[S_VY]) == (0.0, 0.0, pytest.approx(0.0, abs=1e-9))
+
+
+def test_the_packed_kernel_matches_advance_for_a_holonomic_body() -> None:
+    footprint = circle_polygon(0.15)
+    walls = np.array([[0.6, -1.0, 0.6, 1.0]])
+    noise = np.zeros((8, 2))
+    params = np.array([0.2, 0.05, 0.0, 0.02, inner_radius(footprint), DRIVE_HOLONOMIC])
+    st = np.zeros(STATE_SIZE)
+    st[S_CVX], st[S_CVY], st[S_CW] = 0.4, 0.3, -0.7
+    pack = PhysicsPack(st, params, 0.01, footprint, walls, np.zeros((0, 3)), noise)
+    near = np.zeros(1, dtype=np.int64)
+    for steps in (1, 7, 60, 200):
+        advance_packed(pack.array, near, 0, steps)
+        advance(st, params, 0.01, footprint, walls, np.zeros((0, 3)), near, noise, 0, steps)
+        assert pack.state.tobytes() == st.tobytes()
+    assert st[S_CONTACT] == 1.0 and st[S_X] < 0.6

@@ -170,43 +170,6 @@ def _cover(
 
 
 @numba.njit(cache=True, nogil=True)
-def _wheels(
-    state: np.ndarray,
-    sep: float,
-    radius: float,
-    max_delta: float,
-    slip: float,
-    noise: np.ndarray,
-    noise_pos: int,
-    dt: float,
-) -> tuple[float, float, int]:
-    """One step of the differential drive's wheels: speeds ramped to their targets, wheel
-    angles, encoder odometry, slip. Returns the body twist ``(v, w)`` the ground gives and
-    the next noise row."""
-    vl = _approach(state[S_VL], state[S_TL], max_delta)
-    vr = _approach(state[S_VR], state[S_TR], max_delta)
-    state[S_VL] = vl
-    state[S_VR] = vr
-    state[S_AL] = _wrap(state[S_AL] + vl * dt / radius)
-    state[S_AR] = _wrap(state[S_AR] + vr * dt / radius)
-    # encoders integrate what the wheels turned
-    ev = 0.5 * (vl + vr)
-    ew = (vr - vl) / sep
-    state[S_EX], state[S_EY], state[S_ETH] = _arc(
-        state[S_EX], state[S_EY], state[S_ETH], ev, ew, dt
-    )
-    # the ground moves the body by slightly different amounts (slip)
-    tl, tr = vl, vr
-    if slip > 0.0 and (vl != 0.0 or vr != 0.0):
-        if noise_pos >= noise.shape[0]:
-            noise_pos = 0
-        tl = vl * (1.0 + slip * noise[noise_pos, 0])
-        tr = vr * (1.0 + slip * noise[noise_pos, 1])
-        noise_pos += 1
-    return 0.5 * (tl + tr), (tr - tl) / sep, noise_pos
-
-
-@numba.njit(cache=True, nogil=True)
 def advance(
     state: np.ndarray,
     params: np.ndarray,
@@ -243,7 +206,28 @@ def advance(
             v, vy, w = state[S_CVX], state[S_CVY], state[S_CW]
             gx, gy, gth = _glide(x0, y0, th0, v, vy, w, dt)
         else:
-            v, w, noise_pos = _wheels(state, sep, radius, max_delta, slip, noise, noise_pos, dt)
+            vl = _approach(state[S_VL], state[S_TL], max_delta)
+            vr = _approach(state[S_VR], state[S_TR], max_delta)
+            state[S_VL] = vl
+            state[S_VR] = vr
+            state[S_AL] = _wrap(state[S_AL] + vl * dt / radius)
+            state[S_AR] = _wrap(state[S_AR] + vr * dt / radius)
+            # encoders integrate what the wheels turned
+            ev = 0.5 * (vl + vr)
+            ew = (vr - vl) / sep
+            state[S_EX], state[S_EY], state[S_ETH] = _arc(
+                state[S_EX], state[S_EY], state[S_ETH], ev, ew, dt
+            )
+            # the ground moves the body by slightly different amounts (slip)
+            tl, tr = vl, vr
+            if slip > 0.0 and (vl != 0.0 or vr != 0.0):
+                if noise_pos >= noise.shape[0]:
+                    noise_pos = 0
+                tl = vl * (1.0 + slip * noise[noise_pos, 0])
+                tr = vr * (1.0 + slip * noise[noise_pos, 1])
+                noise_pos += 1
+            v = 0.5 * (tl + tr)
+            w = (tr - tl) / sep
             vy = 0.0
             gx, gy, gth = _arc(x0, y0, th0, v, w, dt)
         contact = False
