@@ -1,5 +1,6 @@
-"""gazebo_ros plugins of popular robots beyond the diff drive: skid steer (husky, rosbot)
-and the imu sensor plugin, read with the plugins' own defaults and simulated."""
+"""gazebo_ros plugins of popular robots beyond the diff drive: skid steer (husky, rosbot),
+planar move (omni-wheel and mecanum bases) and the imu sensor plugin, read with the
+plugins' own defaults and simulated (the planar move's simulation: tests/sim)."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ from typing import Any
 import pytest
 
 from roverlab.core import Context
-from roverlab.description import ImuPluginSpec, URDFError, load_robot
+from roverlab.description import DescriptionError, ImuPluginSpec, URDFError, load_robot
 from roverlab.description.check import format_check, robot_warnings
 from roverlab.msgs import Twist
 from roverlab.sim.app import Simulation
@@ -183,4 +184,78 @@ def test_gazebo_ros_control_is_warned_with_what_it_means() -> None:
     )
     (hint,) = [w for w in robot_warnings(m) if "ros_control controllers" in w]
     assert hint.startswith("<string>: libgazebo_ros_control.so: ros_control controllers")
-    assert "libgazebo_ros_diff_drive.so" in hint
+    assert "libgazebo_ros_diff_drive.so" in hint and "libgazebo_ros_planar_move.so" in hint
+
+
+def _planar(plugin: str) -> str:
+    return (
+        '<robot name="omni"><link name="base_footprint"/><link name="base_link"/>'
+        '<joint name="j" type="fixed"><parent link="base_footprint"/><child link="base_link"/>'
+        '</joint><gazebo><plugin name="omni" filename="libgazebo_ros_planar_move.so">'
+        f"{plugin}</plugin></gazebo></robot>"
+    )
+
+
+def test_planar_move_is_read_with_noetic_s_defaults() -> None:
+    m = load_robot(_planar(""))
+    spec = m.gazebo.planar_move
+    assert spec is not None and m.gazebo.drive is spec and m.gazebo.diff_drive is None
+    assert (spec.command_topic, spec.odometry_topic) == ("/cmd_vel", "/odom")
+    assert (spec.odometry_frame, spec.robot_base_frame) == ("odom", "base_footprint")
+    assert (spec.odometry_rate_hz, spec.cmd_timeout_s, spec.publish_odometry_tf) == (
+        20.0,
+        -1.0,
+        True,
+    )
+    # simulated now: no longer among the plugins "not simulated (ignored)"
+    assert m.gazebo.unsupported_plugins == ()
+    assert not [w for w in robot_warnings(m) if "planar_move" in w]
+    text = format_check(m)
+    assert (
+        "omni [libgazebo_ros_planar_move.so] on model: holonomic (linear.x, linear.y, "
+        "angular.z), /cmd_vel -> /odom at 20 Hz (odom -> base_footprint)"
+    ) in text
+    assert "unsupported" not in text
+
+
+def test_planar_move_names_rates_and_switches() -> None:
+    m = load_robot(
+        _planar(
+            "<robotNamespace>/omni</robotNamespace><commandTopic>cmd_vel</commandTopic>"
+            "<odometryTopic>odom</odometryTopic><odometryFrame>odom</odometryFrame>"
+            "<robotBaseFrame>base_link</robotBaseFrame><odometryRate>50.0</odometryRate>"
+            "<cmdTimeout>0.5</cmdTimeout><publishOdometryTf>false</publishOdometryTf>"
+        )
+    )
+    spec = m.gazebo.planar_move
+    assert spec is not None
+    # topics live in the namespace; frames get only the tf_prefix parameter's prefix
+    assert (spec.command_topic, spec.odometry_topic) == ("/omni/cmd_vel", "/omni/odom")
+    assert (spec.odometry_frame, spec.robot_base_frame) == ("odom", "base_link")
+    assert (spec.odometry_rate_hz, spec.cmd_timeout_s) == (50.0, 0.5)
+    assert not spec.publish_odometry_tf
+    text = format_check(m)
+    assert "at 50 Hz (odom -> base_link), no odom transform (publishOdometryTf false" in text
+    assert "stops 0.5 s after the last command" in text
+    config = sim_config_from_model(m)
+    assert config.base_frame == "base_link" and config.drive is not None
+    assert config.drive.robot_base_frame == "base_link"
+    quiet = format_check(load_robot(_planar("<odometryRate>0</odometryRate>")))
+    assert "/cmd_vel, no odometry (odometryRate 0)" in quiet
+
+
+def test_planar_move_bad_values_are_one_clear_error() -> None:
+    with pytest.raises(URDFError, match=r"planar_move.so'>: <odometryRate>: -1 must not be neg"):
+        load_robot(_planar("<odometryRate>-1</odometryRate>"))
+    with pytest.raises(URDFError, match=r"<publishOdometryTf>: 'maybe' is not a boolean"):
+        load_robot(_planar("<publishOdometryTf>maybe</publishOdometryTf>"))
+    with pytest.raises(DescriptionError, match=r"planar move robotBaseFrame 'chassis' is not"):
+        sim_config_from_model(load_robot(_planar("<robotBaseFrame>chassis</robotBaseFrame>")))
+
+
+def test_a_second_drive_plugin_is_warned() -> None:
+    second = '<gazebo><plugin name="b" filename="libgazebo_ros_planar_move.so"/></gazebo>'
+    m = load_robot(_planar("").replace("</robot>", second + "</robot>"))
+    assert len(m.gazebo.plugins) == 2
+    (w,) = [w for w in robot_warnings(m) if "drive plugins" in w]
+    assert "2 drive plugins: the first (libgazebo_ros_planar_move.so) moves the robot" in w

@@ -11,6 +11,7 @@ from roverlab.raycast import Scene
 from roverlab.sim.collision import Obstacles, circle_polygon, inner_radius, polygon_hits
 from roverlab.sim.diff_drive import DiffDriveParams
 from roverlab.sim.dynamics import (
+    DRIVE_DIFF,
     S_AL,
     S_CONTACT,
     S_CONTACTS,
@@ -42,7 +43,7 @@ def _state(vl: float, vr: float) -> np.ndarray:
 
 
 def _params(acc: float = 0.0, slip: float = 0.0) -> np.ndarray:
-    return np.array([SEP, DIAM, acc, slip, inner_radius(FOOTPRINT)])
+    return np.array([SEP, DIAM, acc, slip, inner_radius(FOOTPRINT), DRIVE_DIFF])
 
 
 def _run(

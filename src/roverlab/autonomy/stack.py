@@ -137,7 +137,8 @@ def start_explore_stack(
     )  # fmt: skip
     if simulation.config.drive is None:
         raise AutonomyError(
-            f"robot {robot}: no differential-drive plugin, move_base cannot drive it"
+            f"robot {robot}: no drive plugin (diff drive, skid steer or planar move), "
+            "move_base cannot drive it"
         )
     spec = load_launch(
         find_package("robot_navigation") / "launch" / "explore.launch",

@@ -28,6 +28,7 @@ from roverlab.description.gazebo_specs import (
     ImuSpec,
     KinectPluginSpec,
     LaserPluginSpec,
+    PlanarMoveSpec,
 )
 from roverlab.description.meshes import mesh_points
 from roverlab.description.model import Mesh, RobotModel
@@ -54,7 +55,8 @@ def robot_warnings(model: RobotModel) -> list[str]:
         out.append(
             f"{src}: libgazebo_ros_control.so: ros_control controllers (diff_drive_controller, "
             "joint_state_controller) are not run, so nothing moves the robot on cmd_vel; "
-            "add a libgazebo_ros_diff_drive.so or libgazebo_ros_skid_steer_drive.so plugin"
+            "add a libgazebo_ros_diff_drive.so or libgazebo_ros_skid_steer_drive.so plugin "
+            "(libgazebo_ros_planar_move.so for an omni-wheel or mecanum base)"
         )
     if sensors:
         out.append(f"{src}: Gazebo sensor types not simulated (ignored): {', '.join(sensors)}")
@@ -101,8 +103,16 @@ def robot_notes(model: RobotModel, *, detail: bool = False) -> list[str]:
 
 
 def _drive_warnings(model: RobotModel) -> list[str]:
-    """gazebo_ros_diff_drive settings the simulator's kinematic drive does not act on."""
+    """gazebo_ros_diff_drive settings the simulator's kinematic drive does not act on, and
+    drive plugins beyond the first (Gazebo would run them all, fighting over the body)."""
     out: list[str] = []
+    drives = [p for p in model.gazebo.plugins if isinstance(p.spec, DiffDriveSpec | PlanarMoveSpec)]
+    if len(drives) > 1:
+        out.append(
+            f"{model.source}: {len(drives)} drive plugins: the first "
+            f"({drives[0].filename}) moves the robot; not simulated: "
+            + ", ".join(p.filename for p in drives[1:])
+        )
     for plugin in model.gazebo.plugins:
         spec = plugin.spec
         if not isinstance(spec, DiffDriveSpec):
@@ -212,6 +222,8 @@ def _plugin_line(p: GazeboPlugin) -> str:
             f"{spec.command_topic} -> {spec.odometry_topic} "
             f"({spec.odometry_frame} -> {spec.robot_base_frame})"
         )
+    elif isinstance(spec, PlanarMoveSpec):
+        detail = _planar_move_detail(spec)
     elif isinstance(spec, LaserPluginSpec):
         detail = f": {spec.topic} in frame {spec.frame_id}"
     elif isinstance(spec, CameraPluginSpec):
@@ -232,6 +244,22 @@ def _plugin_line(p: GazeboPlugin) -> str:
     else:
         detail = ": not supported by roverlab (ignored)"
     return head + detail
+
+
+def _planar_move_detail(spec: PlanarMoveSpec) -> str:
+    out = f": holonomic (linear.x, linear.y, angular.z), {spec.command_topic}"
+    if spec.odometry_rate_hz > 0:
+        out += (
+            f" -> {spec.odometry_topic} at {_num(spec.odometry_rate_hz)} Hz "
+            f"({spec.odometry_frame} -> {spec.robot_base_frame})"
+        )
+        if not spec.publish_odometry_tf:
+            out += ", no odom transform (publishOdometryTf false: roverlab's switch)"
+    else:
+        out += ", no odometry (odometryRate 0)"
+    if spec.cmd_timeout_s >= 0:
+        out += f", stops {_num(spec.cmd_timeout_s)} s after the last command"
+    return out
 
 
 def format_check(model: RobotModel) -> str:

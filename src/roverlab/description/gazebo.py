@@ -31,8 +31,8 @@ from types import MappingProxyType
 from typing import Final
 
 from roverlab.description.errors import URDFError
+from roverlab.description.gazebo_planar import parse_planar_move
 from roverlab.description.gazebo_specs import (
-    NOISE_TYPES,
     CameraPluginSpec,
     CameraSpec,
     DiffDriveSpec,
@@ -51,106 +51,14 @@ from roverlab.description.gazebo_specs import (
     resolve_frame,
     resolve_topic,
 )
+from roverlab.description.gazebo_values import ElementValues, flatten_element
 from roverlab.geometry import Transform3, quat_from_rpy
 
 __all__ = ["PLUGIN_SPECS", "REFERENCE_KEYS", "parse_gazebo"]
 
 
 # --------------------------------------------------------------------------- parsing
-class _Values:
-    """Typed reads of child-element text, errors naming ``where``."""
-
-    def __init__(self, values: Mapping[str, str], where: str, model_name: str = "") -> None:
-        self.values = values
-        self.where = where
-        self.model_name = model_name
-
-    def fail(self, key: str, problem: str) -> URDFError:
-        return URDFError(f"{self.where}: <{key}>: {problem}")
-
-    def text(self, key: str, default: str) -> str:
-        value = self.values.get(key)
-        return default if value is None else value.strip()
-
-    def noise_type(self, key: str) -> str:
-        """A ``<noise><type>``: Gazebo's ``none``, ``gaussian`` or ``gaussian_quantized``
-        (Gazebo prints an error and adds no noise for any other; roverlab refuses it)."""
-        value = self.text(key, "none")
-        if value not in NOISE_TYPES:
-            raise self.fail(key, f"unknown noise type '{value}' (one of {', '.join(NOISE_TYPES)})")
-        return value
-
-    def number(self, key: str, default: float) -> float:
-        raw = self.values.get(key)
-        if raw is None or not raw.strip():
-            return default
-        try:
-            value = float(raw)
-        except ValueError:
-            raise self.fail(key, f"'{raw.strip()}' is not a number") from None
-        if not math.isfinite(value):
-            raise self.fail(key, f"'{raw.strip()}' is not a finite number")
-        return value
-
-    def non_negative(self, key: str, default: float) -> float:
-        value = self.number(key, default)
-        if value < 0:
-            raise self.fail(key, f"{value:g} must not be negative")
-        return value
-
-    def integer(self, key: str, default: int, *, minimum: int = 0) -> int:
-        raw = self.values.get(key)
-        if raw is None or not raw.strip():
-            return default
-        try:
-            value = int(raw.strip())
-        except ValueError:
-            raise self.fail(key, f"'{raw.strip()}' is not an integer") from None
-        if value < minimum:
-            raise self.fail(key, f"{value} must be >= {minimum}")
-        return value
-
-    def flag(self, key: str, default: bool) -> bool:
-        raw = self.values.get(key)
-        if raw is None or not raw.strip():
-            return default
-        word = raw.strip().lower()
-        if word in ("true", "1"):
-            return True
-        if word in ("false", "0"):
-            return False
-        raise self.fail(key, f"'{raw.strip()}' is not a boolean (true/false/1/0)")
-
-    def vector(self, key: str, default: tuple[float, float, float]) -> tuple[float, float, float]:
-        raw = self.values.get(key)
-        if raw is None or not raw.strip():
-            return default
-        parts = raw.split()
-        try:
-            nums = [float(p) for p in parts]
-        except ValueError:
-            raise self.fail(key, f"'{raw.strip()}' is not 3 numbers") from None
-        if len(nums) != 3 or not all(math.isfinite(v) for v in nums):
-            raise self.fail(key, f"'{raw.strip()}' is not 3 finite numbers")
-        return (nums[0], nums[1], nums[2])
-
-
-def _flatten(elem: ET.Element, prefix: str = "") -> dict[str, str]:
-    """Child element texts by tag; nested elements as ``a/b`` (the first occurrence wins)."""
-    out: dict[str, str] = {}
-    for child in elem:
-        if not isinstance(child.tag, str):
-            continue
-        key = prefix + child.tag
-        if len(child):
-            for k, v in _flatten(child, key + "/").items():
-                out.setdefault(k, v)
-        else:
-            out.setdefault(key, (child.text or "").strip())
-    return out
-
-
-def _noise(values: _Values, prefix: str) -> NoiseSpec:
+def _noise(values: ElementValues, prefix: str) -> NoiseSpec:
     return NoiseSpec(
         type=values.noise_type(prefix + "type"),
         mean=values.number(prefix + "mean", 0.0),
@@ -165,7 +73,7 @@ def _imu_noise(elem: ET.Element | None, where: str) -> ImuSpec | None:
     per-axis form (``angular_velocity/x/noise``; the x axis stands for all three)."""
     if elem is None:
         return None
-    v = _Values(_flatten(elem), where + ": <imu>")
+    v = ElementValues(flatten_element(elem), where + ": <imu>")
     keys = v.values.keys()
     if any(k.startswith("noise/") for k in keys):
         noise_type = v.noise_type("noise/type")
@@ -179,7 +87,7 @@ def _imu_noise(elem: ET.Element | None, where: str) -> ImuSpec | None:
     def axis(noise: ET.Element | None, what: str) -> NoiseSpec:
         if noise is None:
             return NoiseSpec()
-        values = _Values({**_flatten(noise), "type": noise.get("type", "none")},
+        values = ElementValues({**flatten_element(noise), "type": noise.get("type", "none")},
                          f"{where}: <imu> {what}")  # fmt: skip
         return _noise(values, "")
 
@@ -199,7 +107,7 @@ def _pose(text: str | None, where: str) -> Transform3:
 
 
 def _ray(elem: ET.Element, where: str) -> RaySpec:
-    v = _Values(_flatten(elem), where + ": <ray>")
+    v = ElementValues(flatten_element(elem), where + ": <ray>")
     vertical = None
     if elem.find("scan/vertical") is not None:
         vertical = ScanAxis(
@@ -229,7 +137,7 @@ def _ray(elem: ET.Element, where: str) -> RaySpec:
 
 
 def _camera(elem: ET.Element, where: str) -> CameraSpec:
-    v = _Values(_flatten(elem), where + ": <camera>")
+    v = ElementValues(flatten_element(elem), where + ": <camera>")
     spec = CameraSpec(
         horizontal_fov=v.number("horizontal_fov", 1.047),
         width=v.integer("image/width", 320, minimum=1),
@@ -248,7 +156,7 @@ def _camera(elem: ET.Element, where: str) -> CameraSpec:
 
 
 # ----------------------------------------------------------------- plugin specs
-def _diff_drive(v: _Values, plugin: GazeboPlugin) -> DiffDriveSpec:
+def _diff_drive(v: ElementValues, plugin: GazeboPlugin) -> DiffDriveSpec:
     ns = v.text("robotNamespace", "")
     source = v.text("odometrySource", "world")
     if source not in ("world", "encoder"):
@@ -279,7 +187,7 @@ def _diff_drive(v: _Values, plugin: GazeboPlugin) -> DiffDriveSpec:
     return spec
 
 
-def _skid_steer(v: _Values, plugin: GazeboPlugin) -> DiffDriveSpec:
+def _skid_steer(v: ElementValues, plugin: GazeboPlugin) -> DiffDriveSpec:
     """``libgazebo_ros_skid_steer_drive.so``: four wheels, the diff drive's kinematics;
     odometry is always the model's world pose, the odom transform only with
     ``broadcastTF`` (default false), ``torque`` (not ``wheelTorque``) on each wheel."""
@@ -309,7 +217,7 @@ def _skid_steer(v: _Values, plugin: GazeboPlugin) -> DiffDriveSpec:
     return spec
 
 
-def _laser(v: _Values, plugin: GazeboPlugin) -> LaserPluginSpec:
+def _laser(v: ElementValues, plugin: GazeboPlugin) -> LaserPluginSpec:
     ns = v.text("robotNamespace", "")
     return LaserPluginSpec(
         topic=resolve_topic(ns, v.text("topicName", "/world")),
@@ -318,19 +226,19 @@ def _laser(v: _Values, plugin: GazeboPlugin) -> LaserPluginSpec:
     )
 
 
-def _distortion(v: _Values, name: str) -> float:
+def _distortion(v: ElementValues, name: str) -> float:
     """``distortionK1`` (what the camera utils read) or ``distortion_k1`` (seen in tutorials)."""
     camel = "distortion" + name.upper()
     snake = "distortion_" + name.lower()
     return v.number(camel, v.number(snake, 0.0))
 
 
-def _distortions(v: _Values) -> dict[str, float]:
+def _distortions(v: ElementValues) -> dict[str, float]:
     """The five ``distortion_*`` fields of a camera plugin spec."""
     return {f"distortion_{k}": _distortion(v, k) for k in ("k1", "k2", "k3", "t1", "t2")}
 
 
-def _camera_plugin(v: _Values, plugin: GazeboPlugin) -> CameraPluginSpec:
+def _camera_plugin(v: ElementValues, plugin: GazeboPlugin) -> CameraPluginSpec:
     ns = v.text("robotNamespace", "")
     name = v.text("cameraName", "")
     camera_ns = f"{ns}/{name}"
@@ -346,7 +254,7 @@ def _camera_plugin(v: _Values, plugin: GazeboPlugin) -> CameraPluginSpec:
     )
 
 
-def _kinect(v: _Values, plugin: GazeboPlugin) -> KinectPluginSpec:
+def _kinect(v: ElementValues, plugin: GazeboPlugin) -> KinectPluginSpec:
     ns = v.text("robotNamespace", "")
     name = v.text("cameraName", "")
     cns = f"{ns}/{name}"
@@ -372,7 +280,7 @@ def _kinect(v: _Values, plugin: GazeboPlugin) -> KinectPluginSpec:
     return spec
 
 
-def _imu_plugin(v: _Values, plugin: GazeboPlugin, elem: ET.Element) -> ImuPluginSpec:
+def _imu_plugin(v: ElementValues, plugin: GazeboPlugin, elem: ET.Element) -> ImuPluginSpec:
     ns = v.text("robotNamespace", "")
     body = v.text("bodyName", "")
     if not body:
@@ -391,7 +299,7 @@ def _imu_plugin(v: _Values, plugin: GazeboPlugin, elem: ET.Element) -> ImuPlugin
     )
 
 
-def _imu_sensor_plugin(v: _Values, plugin: GazeboPlugin, elem: ET.Element) -> ImuPluginSpec:
+def _imu_sensor_plugin(v: ElementValues, plugin: GazeboPlugin, elem: ET.Element) -> ImuPluginSpec:
     """``libgazebo_ros_imu_sensor.so`` (noetic): the sensor's own measurements (with its
     ``<imu>`` noise, filled in by ``_sensor``) plus ``gaussianNoise``, at ``updateRateHZ``
     (default 1 Hz), on ``<robotNamespace>/<topicName>`` (default namespace: the model's
@@ -418,12 +326,13 @@ def _imu_sensor_plugin(v: _Values, plugin: GazeboPlugin, elem: ET.Element) -> Im
     )
 
 
-_SpecParser = Callable[[_Values, GazeboPlugin, ET.Element], PluginSpec]
+_SpecParser = Callable[[ElementValues, GazeboPlugin, ET.Element], PluginSpec]
 
 PLUGIN_SPECS: Final[Mapping[str, _SpecParser]] = MappingProxyType(
     {
         "libgazebo_ros_diff_drive.so": lambda v, p, e: _diff_drive(v, p),
         "libgazebo_ros_skid_steer_drive.so": lambda v, p, e: _skid_steer(v, p),
+        "libgazebo_ros_planar_move.so": lambda v, p, e: parse_planar_move(v),
         "libgazebo_ros_laser.so": lambda v, p, e: _laser(v, p),
         "libgazebo_ros_gpu_laser.so": lambda v, p, e: _laser(v, p),
         "libgazebo_ros_camera.so": lambda v, p, e: _camera_plugin(v, p),
@@ -448,12 +357,12 @@ def _plugin(
         filename=filename,
         reference=sensor,
         link=link,
-        params=MappingProxyType(_flatten(elem)),
+        params=MappingProxyType(flatten_element(elem)),
     )
     parser = PLUGIN_SPECS.get(filename)
     if parser is None:
         return plugin
-    spec = parser(_Values(plugin.params, label, model_name), plugin, elem)
+    spec = parser(ElementValues(plugin.params, label, model_name), plugin, elem)
     return GazeboPlugin(plugin.name, filename, sensor, link, plugin.params, spec)
 
 
@@ -481,7 +390,7 @@ def _sensor(elem: ET.Element, link: str, where: str, model_name: str) -> GazeboS
     if not name or not stype:
         raise URDFError(f"{label}: a sensor needs a name and a type")
     simple = {c.tag: (c.text or "").strip() for c in elem if isinstance(c.tag, str) and not len(c)}
-    v = _Values(simple, label)
+    v = ElementValues(simple, label)
     ray = camera = imu = None
     if stype in ("ray", "gpu_ray"):
         ray_elem = elem.find("ray")
@@ -531,7 +440,7 @@ REFERENCE_KEYS: Final = {
 
 
 def _reference(name: str, values: dict[str, str], where: str) -> GazeboReference:
-    v = _Values(values, where)
+    v = ElementValues(values, where)
 
     def opt(key: str) -> float | None:
         return v.number(key, math.nan) if key in values else None

@@ -239,6 +239,31 @@ class DiffDriveSpec:
 
 
 @dataclass(frozen=True, slots=True)
+class PlanarMoveSpec:
+    """``libgazebo_ros_planar_move.so`` (ROS 1 noetic) with its defaults: a holonomic base
+    whose body-frame velocity is set straight from ``cmd_vel``'s ``linear.x``,
+    ``linear.y`` and ``angular.z`` (no acceleration limit, no wheels).
+
+    Topics are absolute (in ``robotNamespace``); frames are not prefixed with the
+    namespace (the plugin resolves them with the ``tf_prefix`` parameter only).
+    ``odometry_rate_hz`` 0 publishes neither odometry nor the transform. A negative
+    ``cmd_timeout_s`` (the default) keeps the last command forever; otherwise the body
+    stops once no command came for that long. ``publish_odometry_tf`` is roverlab's: the
+    noetic plugin always broadcasts ``odom -> robotBaseFrame`` (``publishOdometryTf``, as
+    gazebo_ros_force_based_move names it, switches it off here).
+    """
+
+    command_topic: str = "/cmd_vel"
+    odometry_topic: str = "/odom"
+    odometry_frame: str = "odom"
+    robot_base_frame: str = "base_footprint"
+    odometry_rate_hz: float = 20.0
+    cmd_timeout_s: float = -1.0
+    publish_odometry_tf: bool = True
+    robot_namespace: str = ""
+
+
+@dataclass(frozen=True, slots=True)
 class LaserPluginSpec:
     """``libgazebo_ros_laser.so`` / ``libgazebo_ros_gpu_laser.so`` (defaults ``/world``)."""
 
@@ -311,9 +336,22 @@ class ImuPluginSpec:
     robot_namespace: str = ""
 
 
-PluginSpec = DiffDriveSpec | LaserPluginSpec | CameraPluginSpec | KinectPluginSpec | ImuPluginSpec
+PluginSpec = (
+    DiffDriveSpec
+    | PlanarMoveSpec
+    | LaserPluginSpec
+    | CameraPluginSpec
+    | KinectPluginSpec
+    | ImuPluginSpec
+)
 _SpecT = TypeVar(
-    "_SpecT", DiffDriveSpec, LaserPluginSpec, CameraPluginSpec, KinectPluginSpec, ImuPluginSpec
+    "_SpecT",
+    DiffDriveSpec,
+    PlanarMoveSpec,
+    LaserPluginSpec,
+    CameraPluginSpec,
+    KinectPluginSpec,
+    ImuPluginSpec,
 )
 
 
@@ -434,6 +472,21 @@ class GazeboExtensions:
         """The (first) differential-drive plugin, if any."""
         found = self.specs(DiffDriveSpec)
         return found[0] if found else None
+
+    @property
+    def planar_move(self) -> PlanarMoveSpec | None:
+        """The (first) planar-move (holonomic) plugin, if any."""
+        found = self.specs(PlanarMoveSpec)
+        return found[0] if found else None
+
+    @property
+    def drive(self) -> DiffDriveSpec | PlanarMoveSpec | None:
+        """The plugin that moves the robot on ``cmd_vel``: the first diff-drive,
+        skid-steer or planar-move plugin in document order."""
+        for p in self.plugins:
+            if isinstance(p.spec, DiffDriveSpec | PlanarMoveSpec):
+                return p.spec
+        return None
 
     @property
     def unsupported_plugins(self) -> tuple[GazeboPlugin, ...]:

@@ -15,6 +15,7 @@ from roverlab.core import Context
 from roverlab.description import RobotModel, find_package, load_robot
 from roverlab.description.node import JointStatePublisher, RobotStatePublisher
 from roverlab.errors import RoverlabError
+from roverlab.sim.config import DiffDriveConfig
 from roverlab.sim.node import SimulatorNode, SpawnPose
 from roverlab.sim.robot import sim_config_from_model
 from roverlab.world import World, load_world
@@ -98,7 +99,8 @@ class Simulation:
         self.state_publisher = RobotStatePublisher(
             context=self.context, robot_description=self.robot_model
         )
-        wheel_states = self.config.drive is not None and self.config.drive.publish_wheel_joint_state
+        drive = self.config.drive
+        wheel_states = isinstance(drive, DiffDriveConfig) and drive.publish_wheel_joint_state
         self.joint_state_publisher = (
             None
             if wheel_states or not self.robot_model.movable_joints

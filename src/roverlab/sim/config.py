@@ -6,6 +6,7 @@ sim_config_from_model`; kept separate so the simulator core never parses XML.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -21,6 +22,7 @@ __all__ = [
     "DiffDriveConfig",
     "ImuSensor",
     "LidarSensor",
+    "PlanarMoveConfig",
     "RobotSimConfig",
 ]
 
@@ -40,6 +42,41 @@ class DiffDriveConfig:
     update_rate_hz: float = 100.0
     left_joint: str = "left_wheel_joint"
     right_joint: str = "right_wheel_joint"
+
+
+@dataclass(frozen=True)
+class PlanarMoveConfig:
+    """libgazebo_ros_planar_move.so: a holonomic base moved at the commanded body twist.
+
+    Args:
+        odometry_rate_hz: odometry (and transform) messages per second; 0: none.
+        cmd_timeout_s: the body stops once no command came for this long; < 0: never.
+        publish_odom_tf: broadcast ``odometry_frame -> robot_base_frame``.
+        max_speed_mps: clamp of the commanded linear speed (a guard against absurd
+            commands; the plugin has no limit), keeping its direction.
+        max_turn_rate_rad_s: clamp of the commanded turn rate (the same guard).
+
+    Raises:
+        ValueError: a negative or non-finite rate or limit, a non-finite timeout.
+    """
+
+    command_topic: str = "cmd_vel"
+    odometry_topic: str = "odom"
+    odometry_frame: str = "odom"
+    robot_base_frame: str = "base_footprint"
+    odometry_rate_hz: float = 20.0
+    cmd_timeout_s: float = -1.0
+    publish_odom_tf: bool = True
+    max_speed_mps: float = 5.0
+    max_turn_rate_rad_s: float = 10.0
+
+    def __post_init__(self) -> None:
+        for name in ("odometry_rate_hz", "max_speed_mps", "max_turn_rate_rad_s"):
+            v = getattr(self, name)
+            if not (math.isfinite(v) and v >= 0):
+                raise ValueError(f"{name} must be >= 0, got {v}")
+        if not math.isfinite(self.cmd_timeout_s):
+            raise ValueError(f"cmd_timeout_s must be finite, got {self.cmd_timeout_s}")
 
 
 @dataclass(frozen=True)
@@ -98,12 +135,13 @@ class RobotSimConfig:
 
     ``footprint`` is the body's outline on the floor (body frame, (K, 2), convex) and
     ``height_band`` the z range it occupies; ``base_frame`` is the frame the drive moves.
+    ``drive`` is a differential (or skid-steer) drive, a holonomic planar move, or None.
     """
 
     name: str
     footprint: NDArray[np.float64]
     height_band: tuple[float, float]
-    drive: DiffDriveConfig | None
+    drive: DiffDriveConfig | PlanarMoveConfig | None
     lidars: tuple[LidarSensor, ...] = ()
     imus: tuple[ImuSensor, ...] = ()
     cameras: tuple[CameraSensor, ...] = ()

@@ -8,7 +8,14 @@ physics timer, without a Python callback per step.
 State vector layout (float64, see ``S_*``): ground-truth pose, wheel surface speeds and
 targets, wheel angles, encoder-odometry pose, body twist and forward acceleration, the
 contact flag of the last step and the number of contact events so far (a step in contact
-after one that was not), and the broad phase's anchor.
+after one that was not), the broad phase's anchor, then the lateral velocity, the body's
+lateral acceleration and a holonomic drive's commanded body twist.
+
+Two drive kinds (``params[P_KIND]``): the differential drive (:data:`DRIVE_DIFF`: wheel
+speeds ramp to their targets, the body follows the wheels' arc; its lateral velocity is
+zero) and the holonomic base of gazebo_ros_planar_move (:data:`DRIVE_HOLONOMIC`: the
+commanded body twist ``(vx, vy, wz)`` is the body's velocity at once, as the plugin sets
+the model's velocity every update; no wheels, no slip, no encoders).
 
 Broad phase: the contact test only looks at the walls and posts within the footprint's
 circumscribed radius plus a margin of an anchor point, gathered again whenever a step
@@ -29,7 +36,16 @@ from roverlab.sim.collision import any_near, gather_near, polygon_hits_near
 
 F = TypeVar("F", bound=Callable[..., Any])
 
-__all__ = ["STATE_SIZE", "PhysicsPack", "advance", "advance_packed", "compiled_entry"]
+__all__ = [
+    "DRIVE_DIFF",
+    "DRIVE_HOLONOMIC",
+    "N_PARAMS",
+    "STATE_SIZE",
+    "PhysicsPack",
+    "advance",
+    "advance_packed",
+    "compiled_entry",
+]
 
 S_X, S_Y, S_TH = 0, 1, 2
 S_VL, S_VR, S_TL, S_TR = 3, 4, 5, 6
@@ -40,11 +56,17 @@ S_CONTACT = 15
 S_CONTACTS = 16
 # broad phase: the obstacles near an anchor point (indices in the ``near`` work array)
 S_AX, S_AY, S_AREACH, S_NSEG, S_NCIRC, S_RADIUS = 17, 18, 19, 20, 21, 22
-STATE_SIZE = 23
+# body-frame lateral velocity, the body's lateral (y) acceleration as an IMU at the origin
+# feels it (the centripetal v w for the diff drive), a holonomic drive's command (vx, vy, wz)
+S_VY, S_LAT = 23, 24
+S_CVX, S_CVY, S_CW = 25, 26, 27
+STATE_SIZE = 28
 
 BROAD_MARGIN_M = 0.25  # how far the body may move from its anchor before a new gather
 
-P_SEP, P_DIAM, P_ACC, P_SLIP, P_INNER = 0, 1, 2, 3, 4
+P_SEP, P_DIAM, P_ACC, P_SLIP, P_INNER, P_KIND = 0, 1, 2, 3, 4, 5
+N_PARAMS = 6
+DRIVE_DIFF, DRIVE_HOLONOMIC = 0.0, 1.0
 
 
 @numba.njit(cache=True, nogil=True)
@@ -74,6 +96,20 @@ def _arc(
         y - r * (math.cos(th2) - math.cos(th)),
         _wrap(th2),
     )
+
+
+@numba.njit(cache=True, nogil=True)
+def _glide(
+    x: float, y: float, th: float, vx: float, vy: float, w: float, dt: float
+) -> tuple[float, float, float]:
+    """The pose after ``dt`` at a constant body twist ``(vx, vy, w)`` (exact)."""
+    if abs(w) < 1e-9:
+        c, s = math.cos(th), math.sin(th)
+        return x + dt * (vx * c - vy * s), y + dt * (vx * s + vy * c), th
+    th2 = th + w * dt
+    ds = math.sin(th2) - math.sin(th)
+    dc = math.cos(th2) - math.cos(th)
+    return x + (vx * ds + vy * dc) / w, y + (vy * ds - vx * dc) / w, _wrap(th2)
 
 
 @numba.njit(cache=True, nogil=True)
@@ -154,41 +190,48 @@ def advance(
     of the last clear sub-step) and sets ``state[S_CONTACT]``; a contact after a step
     without one counts one event in ``state[S_CONTACTS]``. ``near`` is the broad phase's
     work array (int64, at least as long as ``segments`` and ``circles`` together).
+    ``params`` without ``P_KIND`` (five entries) is a differential drive.
     """
     sep = params[P_SEP]
     radius = 0.5 * params[P_DIAM]
     acc = params[P_ACC]
     slip = params[P_SLIP]
     inner = params[P_INNER]
+    holonomic = params.shape[0] > P_KIND and params[P_KIND] == DRIVE_HOLONOMIC
     buf = np.empty_like(footprint)
     max_delta = acc * dt if acc > 0.0 else 0.0
     for _ in range(steps):
-        vl = _approach(state[S_VL], state[S_TL], max_delta)
-        vr = _approach(state[S_VR], state[S_TR], max_delta)
-        state[S_VL] = vl
-        state[S_VR] = vr
-        state[S_AL] = _wrap(state[S_AL] + vl * dt / radius)
-        state[S_AR] = _wrap(state[S_AR] + vr * dt / radius)
-        # encoders integrate what the wheels turned
-        ev = 0.5 * (vl + vr)
-        ew = (vr - vl) / sep
-        state[S_EX], state[S_EY], state[S_ETH] = _arc(
-            state[S_EX], state[S_EY], state[S_ETH], ev, ew, dt
-        )
-        # the ground moves the body by slightly different amounts (slip)
-        tl, tr = vl, vr
-        if slip > 0.0 and (vl != 0.0 or vr != 0.0):
-            if noise_pos >= noise.shape[0]:
-                noise_pos = 0
-            tl = vl * (1.0 + slip * noise[noise_pos, 0])
-            tr = vr * (1.0 + slip * noise[noise_pos, 1])
-            noise_pos += 1
-        v = 0.5 * (tl + tr)
-        w = (tr - tl) / sep
         x0, y0, th0 = state[S_X], state[S_Y], state[S_TH]
-        gx, gy, gth = _arc(x0, y0, th0, v, w, dt)
+        if holonomic:
+            v, vy, w = state[S_CVX], state[S_CVY], state[S_CW]
+            gx, gy, gth = _glide(x0, y0, th0, v, vy, w, dt)
+        else:
+            vl = _approach(state[S_VL], state[S_TL], max_delta)
+            vr = _approach(state[S_VR], state[S_TR], max_delta)
+            state[S_VL] = vl
+            state[S_VR] = vr
+            state[S_AL] = _wrap(state[S_AL] + vl * dt / radius)
+            state[S_AR] = _wrap(state[S_AR] + vr * dt / radius)
+            # encoders integrate what the wheels turned
+            ev = 0.5 * (vl + vr)
+            ew = (vr - vl) / sep
+            state[S_EX], state[S_EY], state[S_ETH] = _arc(
+                state[S_EX], state[S_EY], state[S_ETH], ev, ew, dt
+            )
+            # the ground moves the body by slightly different amounts (slip)
+            tl, tr = vl, vr
+            if slip > 0.0 and (vl != 0.0 or vr != 0.0):
+                if noise_pos >= noise.shape[0]:
+                    noise_pos = 0
+                tl = vl * (1.0 + slip * noise[noise_pos, 0])
+                tr = vr * (1.0 + slip * noise[noise_pos, 1])
+                noise_pos += 1
+            v = 0.5 * (tl + tr)
+            w = (tr - tl) / sep
+            vy = 0.0
+            gx, gy, gth = _arc(x0, y0, th0, v, w, dt)
         contact = False
-        if v != 0.0 or w != 0.0:
+        if v != 0.0 or w != 0.0 or vy != 0.0:
             dist = math.hypot(gx - x0, gy - y0)
             n = 1
             if inner > 0.0:
@@ -229,12 +272,23 @@ def advance(
                     break
                 px, py = cx, cy
         if contact:
-            moved = math.hypot(gx - x0, gy - y0)
-            v = math.copysign(moved / dt, v) if v != 0.0 else 0.0
+            if holonomic:  # what the body did move, in its frame at the step's start
+                c, s = math.cos(th0), math.sin(th0)
+                v = (c * (gx - x0) + s * (gy - y0)) / dt
+                vy = (c * (gy - y0) - s * (gx - x0)) / dt
+            else:
+                moved = math.hypot(gx - x0, gy - y0)
+                v = math.copysign(moved / dt, v) if v != 0.0 else 0.0
             w = _wrap(gth - th0) / dt
         state[S_X], state[S_Y], state[S_TH] = gx, gy, gth
-        state[S_DV] = (v - state[S_V]) / dt
+        if holonomic:  # the body frame turns: a = dv/dt + w x v
+            state[S_DV] = (v - state[S_V]) / dt - w * vy
+            state[S_LAT] = (vy - state[S_VY]) / dt + w * v
+        else:
+            state[S_DV] = (v - state[S_V]) / dt
+            state[S_LAT] = v * w
         state[S_V] = v
+        state[S_VY] = vy
         state[S_W] = w
         if contact and state[S_CONTACT] == 0.0:
             state[S_CONTACTS] += 1.0
@@ -253,7 +307,7 @@ def advance_packed(pack: np.ndarray, near: np.ndarray, noise_pos: int, steps: in
     """:func:`advance` with its float64 arrays and ``dt`` in one array (see
     :class:`PhysicsPack`): the compiled entry unboxes two arrays per call, not seven."""
     dt = pack[_H]
-    o = _PARAMS + 5
+    o = _PARAMS + N_PARAMS
     n, c = int(pack[_H + 1]), int(pack[_H + 2])
     footprint = pack[o : o + n * c].reshape((n, c))
     o += n * c
@@ -267,7 +321,7 @@ def advance_packed(pack: np.ndarray, near: np.ndarray, noise_pos: int, steps: in
     noise = pack[o : o + n * c].reshape((n, c))
     return advance(
         pack[:STATE_SIZE],
-        pack[_PARAMS : _PARAMS + 5],
+        pack[_PARAMS : _PARAMS + N_PARAMS],
         dt,
         footprint,
         segments,
@@ -283,7 +337,11 @@ class PhysicsPack:
     """One float64 array holding :func:`advance`'s state, parameters, ``dt``, footprint,
     segments, circles and slip noise, for :func:`advance_packed`; ``state`` and
     ``noise`` are views into it (the state updated in place, the noise refilled in
-    place)."""
+    place). ``params`` without ``P_KIND`` (five entries) is a differential drive.
+
+    Raises:
+        ValueError: ``state`` or ``params`` of the wrong size.
+    """
 
     def __init__(
         self,
@@ -295,10 +353,18 @@ class PhysicsPack:
         circles: np.ndarray,
         noise: np.ndarray,
     ) -> None:
+        params = np.asarray(params, dtype=np.float64).reshape(-1)
+        if params.size == P_KIND:
+            params = np.append(params, DRIVE_DIFF)
+        if params.size != N_PARAMS or np.size(state) != STATE_SIZE:
+            raise ValueError(
+                f"need {STATE_SIZE} state entries and {N_PARAMS} parameters, got "
+                f"{np.size(state)} and {params.size}"
+            )
         parts = [np.asarray(a, dtype=np.float64) for a in (footprint, segments, circles, noise)]
         shapes = [(a.shape[0], a.shape[1]) for a in parts]
         head = np.array([float(dt)] + [float(v) for shape in shapes for v in shape])
-        pieces = [np.asarray(state, dtype=np.float64), head, np.asarray(params, dtype=np.float64)]
+        pieces = [np.asarray(state, dtype=np.float64), head, params]
         self.array = np.concatenate(pieces + [a.reshape(-1) for a in parts])
         self.state = self.array[:STATE_SIZE]
         self.noise = self.array[self.array.size - parts[3].size :].reshape(shapes[3])

@@ -1,8 +1,9 @@
 """The simulator node (what ``gazebo_ros`` + the robot's ``<gazebo>`` plugins are in ROS).
 
-Thin: it wires :mod:`roverlab.sim.diff_drive`, :mod:`roverlab.sim.collision` and
-:mod:`roverlab.sim.sensors` to topics, TF and parameters. Every random draw comes from a
-generator spawned from the ``seed`` parameter, so a seeded run is reproducible.
+Thin: it wires :mod:`roverlab.sim.diff_drive`, :mod:`roverlab.sim.planar_move`,
+:mod:`roverlab.sim.collision` and :mod:`roverlab.sim.sensors` to topics, TF and
+parameters. Every random draw comes from a generator spawned from the ``seed``
+parameter, so a seeded run is reproducible.
 """
 
 from __future__ import annotations
@@ -22,23 +23,38 @@ from roverlab.msgs import xyz_to_pointcloud2
 from roverlab.raycast import Scene
 from roverlab.raycast.camera import camera_intrinsics, depth_to_points
 from roverlab.sim.collision import Obstacles, inner_radius
-from roverlab.sim.config import CameraSensor, DepthSensor, ImuSensor, LidarSensor, RobotSimConfig
+from roverlab.sim.config import (
+    CameraSensor,
+    DepthSensor,
+    DiffDriveConfig,
+    ImuSensor,
+    LidarSensor,
+    PlanarMoveConfig,
+    RobotSimConfig,
+)
 from roverlab.sim.diff_drive import DiffDriveParams
 from roverlab.sim.dynamics import (
+    DRIVE_DIFF,
+    DRIVE_HOLONOMIC,
     S_AL,
     S_AR,
     S_CONTACT,
     S_CONTACTS,
+    S_CVX,
+    S_CVY,
+    S_CW,
     S_DV,
     S_ETH,
     S_EX,
     S_EY,
+    S_LAT,
     S_TH,
     S_TL,
     S_TR,
     S_V,
     S_VL,
     S_VR,
+    S_VY,
     S_W,
     S_X,
     S_Y,
@@ -47,6 +63,7 @@ from roverlab.sim.dynamics import (
     advance_packed,
     compiled_entry,
 )
+from roverlab.sim.planar_move import PlanarMovePlugin
 from roverlab.sim.sensors import CameraModel, ImuModel, LidarModel
 from roverlab.tf import TransformBroadcaster
 
@@ -81,12 +98,13 @@ def _diag_cov(values: tuple[float, ...]) -> np.ndarray:
 
 
 class SimulatorNode(Node):
-    """Simulates one differential-drive robot in a static 2.5-D world.
+    """Simulates one differential-drive (or holonomic) robot in a static 2.5-D world.
 
     Publishes what the robot's Gazebo plugins would: odometry and the odom -> base
-    transform (diff drive), scans, IMU, camera and depth images and point clouds; plus the
-    ground-truth pose on ``/ground_truth/state`` (nav_msgs/Odometry in the ``world``
-    frame, like the p3d plugin). ``/clock`` comes from the context.
+    transform (diff drive, skid steer or planar move), scans, IMU, camera and depth
+    images and point clouds; plus the ground-truth pose on ``/ground_truth/state``
+    (nav_msgs/Odometry in the ``world`` frame, like the p3d plugin). ``/clock`` comes
+    from the context.
 
     Parameters: ``seed`` (int), ``physics_rate`` (Hz, default 100), ``wheel_slip``
     (relative 1-sigma slip per wheel and step, default 0.02; acts on encoder odometry
@@ -139,7 +157,7 @@ class SimulatorNode(Node):
             )
         # drive
         self.drive = robot.drive
-        d = self.drive
+        d = self.drive if isinstance(self.drive, DiffDriveConfig) else None
         # the node's wheel_slip parameter sets the drive's slip (DiffDriveParams validates)
         p = replace(d.params if d else DiffDriveParams(1.0, 1.0), slip_stddev=self.wheel_slip)
         self._params = np.array(
@@ -149,6 +167,7 @@ class SimulatorNode(Node):
                 p.wheel_acceleration,
                 p.slip_stddev,
                 inner_radius(self._footprint),
+                DRIVE_HOLONOMIC if isinstance(self.drive, PlanarMoveConfig) else DRIVE_DIFF,
             ]
         )
         self._dt = self._step_ns / 1e9
@@ -167,10 +186,15 @@ class SimulatorNode(Node):
         self._advance = compiled_entry(advance_packed, self._pack, self._near, 0, 0)
         self.tf = TransformBroadcaster(self)
         self._tf_pub = self.tf.publisher
-        self._wheel_k = 2.0 / self.drive.params.wheel_diameter_m if self.drive else 0.0
+        self._wheel_k = 2.0 / d.params.wheel_diameter_m if d else 0.0
         self._mounts: dict[int, tuple[float, float, float, float, float]] = {}
-        if self.drive is not None:
-            d = self.drive
+        self.planar_move = None
+        if isinstance(self.drive, PlanarMoveConfig):
+            self.planar_move = PlanarMovePlugin(
+                node=self, config=self.drive, state=self._state, advance=self.advance,
+                tf_publisher=self._tf_pub,
+            )  # fmt: skip
+        if d is not None:
             self.create_subscription(mc.Twist, d.command_topic, self._on_cmd, 10)
             self.odom_pub = self.create_publisher(mc.Odometry, d.odometry_topic, 10)
             self.joint_pub = (
@@ -208,6 +232,11 @@ class SimulatorNode(Node):
     @property
     def v(self) -> float:
         return self._state_view[S_V]
+
+    @property
+    def vy(self) -> float:
+        """Lateral (body-frame y) velocity: zero but for a holonomic base."""
+        return self._state_view[S_VY]
 
     @property
     def w(self) -> float:
@@ -260,7 +289,7 @@ class SimulatorNode(Node):
         self.advance()
         st = self._state
         st[S_X], st[S_Y], st[S_TH] = x, y, float(wrap_angle(yaw))
-        for i in (S_VL, S_VR, S_TL, S_TR, S_V, S_W, S_DV):
+        for i in (S_VL, S_VR, S_TL, S_TR, S_V, S_W, S_DV, S_VY, S_LAT, S_CVX, S_CVY, S_CW):
             st[i] = 0.0
 
     # ----------------------------------------------------------------- commands
@@ -269,7 +298,7 @@ class SimulatorNode(Node):
         if not (math.isfinite(v) and math.isfinite(w)):
             self.get_logger().warning("ignoring a cmd_vel with a NaN or infinite velocity")
             return
-        assert self.drive is not None
+        assert isinstance(self.drive, DiffDriveConfig)
         self.advance()
         p = self.drive.params
         half = 0.5 * p.wheel_separation_m * w
@@ -279,16 +308,16 @@ class SimulatorNode(Node):
 
     # ----------------------------------------------------------------- odometry
     def odometry_pose(self) -> tuple[float, float, float]:
-        """The pose the diff-drive plugin reports (world pose, or integrated encoders)."""
+        """The pose the drive plugin reports (world pose, or integrated encoders)."""
         self.advance()
         st = self._state
-        if self.drive is not None and self.drive.odometry_source == "encoder":
+        if isinstance(self.drive, DiffDriveConfig) and self.drive.odometry_source == "encoder":
             return float(st[S_EX]), float(st[S_EY]), float(st[S_ETH])
         return float(st[S_X]), float(st[S_Y]), float(st[S_TH])
 
     def _publish_odometry(self) -> None:
         d = self.drive
-        assert d is not None
+        assert isinstance(d, DiffDriveConfig)
         ns = self._executor.now_ns  # a timer callback: the event's time
         if ns >= self._physics_ns + self._step_ns:
             self.advance()
@@ -342,7 +371,7 @@ class SimulatorNode(Node):
             build.odometry(
                 sec, nsec, "world", self.robot.base_frame, self.x, self.y, 0.0,
                 0.0, 0.0, math.sin(half), math.cos(half), zero,
-                self.v, 0.0, 0.0, 0.0, 0.0, self.w, zero,
+                self.v, self.vy, 0.0, 0.0, 0.0, self.w, zero,
             )
         )  # fmt: skip
 
@@ -428,14 +457,14 @@ class SimulatorNode(Node):
             if n is None:
                 rows = iter(take_rows())
                 n = nxt(rows)
-            v, w = state[S_V], state[S_W]
+            w = state[S_W]
             half = 0.5 * state[S_TH]
             sec, nsec = divmod(now, 1_000_000_000)
             publish(
                 imu(
                     sec, nsec, frame, 0.0, 0.0, sin(half), cos(half), cov,
                     n[0], n[1], w + n[2], cov,
-                    state[S_DV] + n[3], v * w + n[4], n[5], cov,
+                    state[S_DV] + n[3], state[S_LAT] + n[4], n[5], cov,
                 )
             )  # fmt: skip
 

@@ -18,6 +18,7 @@ from roverlab.description import (
     KinectPluginSpec,
     LaserPluginSpec,
     NoiseSpec,
+    PlanarMoveSpec,
     RobotModel,
     Sphere,
 )
@@ -31,6 +32,7 @@ from roverlab.sim.config import (
     DiffDriveConfig,
     ImuSensor,
     LidarSensor,
+    PlanarMoveConfig,
     RobotSimConfig,
 )
 from roverlab.sim.diff_drive import DiffDriveParams
@@ -135,16 +137,28 @@ def sim_config_from_model(model: RobotModel) -> RobotSimConfig:
         DescriptionError: a sensor or plugin refers to something the model lacks.
     """
     gz = model.gazebo
-    dd: DiffDriveSpec | None = gz.diff_drive
-    base = dd.robot_base_frame if dd is not None else model.root_link
+    plugin = gz.drive
+    base = plugin.robot_base_frame if plugin is not None else model.root_link
     if base not in model.links:
+        kind = "planar move" if isinstance(plugin, PlanarMoveSpec) else "diff drive"
         raise DescriptionError(
-            f"{model.source}: diff drive robotBaseFrame '{base}' is not a link of the robot"
+            f"{model.source}: {kind} robotBaseFrame '{base}' is not a link of the robot"
         )
     points = _body_points(model, base)
     zs = points[:, 2] if len(points) else np.array([0.0, 0.3])
-    drive = None
-    if dd is not None:
+    drive: DiffDriveConfig | PlanarMoveConfig | None = None
+    if isinstance(plugin, PlanarMoveSpec):
+        drive = PlanarMoveConfig(
+            command_topic=plugin.command_topic,
+            odometry_topic=plugin.odometry_topic,
+            odometry_frame=plugin.odometry_frame,
+            robot_base_frame=plugin.robot_base_frame,
+            odometry_rate_hz=plugin.odometry_rate_hz,
+            cmd_timeout_s=plugin.cmd_timeout_s,
+            publish_odom_tf=plugin.publish_odometry_tf,
+        )
+    elif isinstance(plugin, DiffDriveSpec):
+        dd = plugin
         drive = DiffDriveConfig(
             params=DiffDriveParams(
                 wheel_separation_m=dd.wheel_separation_m,
