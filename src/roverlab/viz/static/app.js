@@ -26,6 +26,13 @@
     return null;
   }
   function layer(slot) { return data.layers[slot] || (data.layers[slot] = {}); }
+  // a points display's scans older than its Decay Time go (never the newest); while some are
+  // left, a frame when the oldest expires. Both views call it before drawing L.points.
+  function expirePoints(d, L) {
+    const now = performance.now(), decay = (d.options.decay_s || 0) * 1000;
+    if (decay > 0) L.points = L.points.filter((p, i) => i === L.points.length - 1 || now - p.t < decay);
+    if (decay > 0 && L.points.length > 1) redraw.requestDrawAt(L.points[0].t + decay);  // it fades
+  }
 
   // ------------------------------------------------------------------ socket
   const token = new URLSearchParams(location.search).get("token");
@@ -223,7 +230,7 @@
   const { onConfig, renderTopics, updateStatus, updateFrameSelects, renderImageTopics, renderJoints } =
     window.vizPanel({ $, view, data, send, redraw, requestDraw, configHooks, paintMap });
   const { worldToScreen, screenToWorld, setTool, getTool, framePose } =
-    window.vizView2d({ $, view, data, send, redraw, requestDraw });
+    window.vizView2d({ $, view, data, send, redraw, requestDraw, expirePoints });
 
   // ------------------------------------------------------------------ drive
   const DRIVE_KEYS = new Set(["i", "j", "l", ",", "k", "u", "o", "m", ".", "I", "J", "L", "<", "U", "O", "M", ">", "t", "b"]);
@@ -254,7 +261,7 @@
 
   // view: setting a property through it asks for a frame (redraw.watch)
   window.viz = { view: redraw.watch(view), data, conn, worldToScreen, screenToWorld, setTool, send, PALETTES,
-                 configHooks, getTool, framePose, redraw, requestDraw };
+                 configHooks, getTool, framePose, redraw, requestDraw, expirePoints };
   connect();
   requestDraw();
 })();

@@ -165,9 +165,7 @@ function updatePoints(slot, d, L) {
     const pts = new THREE.Points(geo, mat); pts.frustumCulled = false;
     return pts;
   });
-  const now = performance.now(), decay = (d.options.decay_s || 0) * 1000;
-  if (decay > 0) L.points = L.points.filter((p, i) => i === L.points.length - 1 || now - p.t < decay);
-  if (decay > 0 && L.points.length > 1) viz.redraw.requestDrawAt(L.points[0].t + decay);  // it fades
+  viz.expirePoints(d, L);
   const key = L.points.length + ":" + (L.version || 0);
   e.obj.material.size = d.options.size_px || 3;
   e.obj.material.transparent = d.options.alpha < 1;

@@ -2,7 +2,7 @@
 // with the canvas 2D API, the mouse (camera and tools) and the toolbar's tools, follow and
 // rotation. app.js sets it up on the page's state (window.vizView2d). No build step.
 "use strict";
-window.vizView2d = ({ $, view, data, send, redraw, requestDraw }) => {
+window.vizView2d = ({ $, view, data, send, redraw, requestDraw, expirePoints }) => {
   const canvas = $("view");
   const g = canvas.getContext("2d");
   let tool = "move";
@@ -66,9 +66,7 @@ window.vizView2d = ({ $, view, data, send, redraw, requestDraw }) => {
   }
   function drawPoints(d, L) {
     if (!L.points) return;
-    const now = performance.now(), decay = (d.options.decay_s || 0) * 1000;
-    if (decay > 0) L.points = L.points.filter((p, i) => i === L.points.length - 1 || now - p.t < decay);
-    if (decay > 0 && L.points.length > 1) redraw.requestDrawAt(L.points[0].t + decay);  // it fades
+    expirePoints(d, L);
     const h = px(d.options.size_px || 3) / 2, s = 2 * h;
     for (const scan of L.points) {
       const st = scan.stride;
