@@ -1,5 +1,6 @@
 """The dashboard page itself in Debian's chromium (Playwright): it loads with nothing
-missing (its icon included: no 404 in the console)."""
+missing (its icon included: no 404 in the console) and hands its token to the requests it
+makes of the server (``viz.withToken``)."""
 
 from __future__ import annotations
 
@@ -56,3 +57,17 @@ def test_page_loads_with_no_console_error_and_its_icon(
         with urllib.request.urlopen(base + path, timeout=10) as reply:
             assert reply.headers["Content-Type"].startswith("image/svg+xml")
             assert reply.read().lstrip().startswith(b"<svg")
+
+
+def test_page_requests_carry_its_token(server: DashboardServer, browser: Any) -> None:
+    page = browser.new_page()
+    try:
+        page.goto(server.url)
+        page.wait_for_function("() => window.viz && viz.conn.connected", timeout=20000)
+        assert page.evaluate("() => viz.withToken('mesh/3')") == f"mesh/3?token={TOKEN}"
+        href = page.evaluate("() => document.getElementById('download-config').href")
+        assert href.endswith(f"/config?token={TOKEN}")
+        status = page.evaluate("async () => (await fetch(viz.withToken('config'))).status")
+        assert status == 200
+    finally:
+        page.close()

@@ -24,8 +24,10 @@ to a save come back as ``{"type": "notice", "level", "text"}``.
 The configuration is shared by every page of one server (like one rviz window).
 
 Security: on a loopback host no token is needed. Any other host requires a token (made up
-and printed once when not given), asked for by the page URL (``/?token=...``) and the
-websocket (``/ws?token=...``); a wrong one gets HTTP 403.
+and printed once when not given), asked for by the page URL (``/?token=...``), the
+websocket (``/ws?token=...``), ``/config`` and ``/mesh/N`` (the page adds its own token:
+``viz.withToken`` of app.js); a wrong one gets HTTP 403. The static files and the icon are
+public.
 """
 
 from __future__ import annotations
