@@ -52,21 +52,60 @@ def test_run_registry_node_serves_static_map(
         server.stop()
 
 
-def test_run_script_from_a_package(
-    cli: Any, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
+def _hello_pkg(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    """Package hello_pkg in ``tmp_path/ws`` (on ROVERLAB_PACKAGE_PATH): its folder."""
     pkg = tmp_path / "ws" / "hello_pkg"
     (pkg / "scripts").mkdir(parents=True)
     (pkg / "package.xml").write_text("<package><name>hello_pkg</name></package>")
-    (pkg / "scripts" / "hello.py").write_text(
+    monkeypatch.setenv("ROVERLAB_PACKAGE_PATH", str(tmp_path / "ws"))
+    return pkg
+
+
+@pytest.mark.parametrize("executable", [True, False])
+def test_run_script_from_a_package(
+    cli: Any, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, executable: bool
+) -> None:
+    script = _hello_pkg(tmp_path, monkeypatch) / "scripts" / "hello.py"
+    script.write_text(
         "import rospy\n"
         "rospy.init_node('hello')\n"
         "rospy.loginfo('hello from %s with %s', rospy.get_name(), rospy.get_param('~who'))\n"
     )
-    monkeypatch.setenv("ROVERLAB_PACKAGE_PATH", str(tmp_path / "ws"))
+    script.chmod(0o755 if executable else 0o644)
     r = cli("run", "--clock", "wall", "hello_pkg", "hello.py", "_who:=ros")
     assert r.returncode == 0, r.stderr
     assert r.stdout.strip().endswith("]: hello from /hello with ros")
+    # rosrun refuses a file without the executable bit: roverlab runs it, with a note
+    notes = [line for line in r.stderr.splitlines() if line.startswith("note: ")]
+    if executable:
+        assert notes == [], r.stderr
+    else:
+        assert notes == [f"note: {script} is not executable (rosrun refuses it; chmod +x it "
+                         "for ROS): run anyway"], r.stderr  # fmt: skip
+
+
+def test_run_refuses_an_ambiguous_or_compiled_package_script(
+    daemon: str,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capfd: pytest.CaptureFixture[str],
+) -> None:
+    pkg = _hello_pkg(tmp_path, monkeypatch)
+    (pkg / "nodes").mkdir()
+    for folder in ("scripts", "nodes"):  # rosrun asks which; roslaunch refuses the node
+        (pkg / folder / "twice.py").write_text("print('ran')\n")
+        (pkg / folder / "twice.py").chmod(0o755)
+    (pkg / "nodes" / "driver_node").write_bytes(b"\x7fELF\x02\x01\x01")
+    (pkg / "nodes" / "driver_node").chmod(0o755)
+    assert run_main(["run", "hello_pkg", "twice.py"]) == 2
+    out, err = capfd.readouterr()
+    assert "ran" not in out
+    (line,) = err.strip().splitlines()
+    assert "multiple files named [twice.py] in package [hello_pkg]" in line
+    assert str(pkg / "nodes" / "twice.py") in line and str(pkg / "scripts" / "twice.py") in line
+    assert run_main(["run", "hello_pkg", "driver_node"]) == 2
+    (line,) = capfd.readouterr().err.strip().splitlines()
+    assert f"{pkg / 'nodes' / 'driver_node'} is not a Python script" in line
 
 
 @pytest.mark.parametrize(

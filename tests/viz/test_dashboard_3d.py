@@ -241,13 +241,14 @@ def _box_stl(path: Path, size: float) -> None:
 
 
 @contextlib.contextmanager
-def _one_mesh_page(browser: Any, urdf: str) -> Iterator[Any]:
+def _one_mesh_page(browser: Any, urdf: str, token: str | None = None) -> Iterator[Any]:
     """A dashboard (showmycar.rviz: Orbit, fixed frame base_link) on a robot_state_publisher
-    of ``urdf`` and a page open on it once its one mesh has loaded."""
+    of ``urdf`` and a page open on it once its one mesh has loaded (``/mesh/0`` asks for
+    ``token`` when one is given: the page adds its own)."""
     ctx = Context()
     RobotStatePublisher(ctx, robot_description=urdf)
     config = load_rviz(URDLEE / "config" / "showmycar.rviz")
-    server = DashboardServer(ctx, "127.0.0.1", 0, config=config)
+    server = DashboardServer(ctx, "127.0.0.1", 0, config=config, token=token)
     ctx.spin_in_thread()
     server.start()
     try:
@@ -266,7 +267,7 @@ def test_stl_mesh_visual_is_loaded_and_drawn(browser: Any, tmp_path: Path) -> No
       <link name="base_link"><visual><geometry><mesh filename="file://{stl}"/></geometry>
         <material name="red"><color rgba="1 0 0 1"/></material></visual></link>
     </robot>"""
-    with _one_mesh_page(browser, urdf) as page:
+    with _one_mesh_page(browser, urdf, token="mesh-token") as page:
         page.evaluate("() => { viz.cam.distance = 2.0; viz.cam.focal.set(0, 0, 0); }")
         page.wait_for_timeout(500)
         img = _shot(page, tmp_path / "stl_mesh.png")

@@ -153,7 +153,9 @@ def launch(
     if note:
         typer.echo(f"note: {note}", err=True)
     # the topics are exposed first: script nodes run in processes of their own
-    scripts = [n for n in spec.nodes if (n.pkg, n.type) not in REGISTRY and find_scripts(n)]
+    scripts = [
+        n for n in spec.nodes if (n.pkg, n.type) not in REGISTRY and find_scripts(n.pkg, n.type)
+    ]
     if scripts and expose is None:
         expose = True  # --rate max too: the scripts must hear the launch
     context = Context(clock=mode, rate=1.0 if math.isinf(pace) else pace)

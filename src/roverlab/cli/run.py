@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import shlex
 from pathlib import Path
 from typing import Annotated
@@ -13,6 +14,7 @@ from roverlab.core import Context, Node, configure_logging
 from roverlab.description import find_package
 from roverlab.description.errors import DescriptionError
 from roverlab.errors import RoverlabError
+from roverlab.launch.process import find_scripts, is_python_script
 from roverlab.launch.registry import REGISTRY, LaunchState
 from roverlab.launch.xml import NodeSpec
 from roverlab.ros1 import run_script
@@ -45,16 +47,43 @@ def _resolve(target: list[str]) -> tuple[Path | None, NodeSpec | None, list[str]
             source=f"roverlab run {pkg} {type_}",
         )
         return None, spec, rest
-    try:
-        folder = find_package(pkg)
-    except DescriptionError as err:
-        raise RunError(f"{pkg} {type_}: not a roverlab node, and {err}") from None
-    matches = sorted(p for p in folder.rglob(type_) if p.is_file())
-    if not matches:
+    return _package_script(pkg, type_), None, rest
+
+
+def _package_script(pkg: str, type_: str) -> Path:
+    """The one file named ``type_`` in package ``pkg`` (``roverlab launch``'s lookup), as
+    rosrun picks it; a file without the executable bit, which rosrun refuses, is noted.
+
+    Raises:
+        RunError: no such package or file, several files of that name, not a Python script.
+    """
+    found = find_scripts(pkg, type_)
+    if not found:
+        try:
+            folder = find_package(pkg)
+        except DescriptionError as err:
+            raise RunError(f"{pkg} {type_}: not a roverlab node, and {err}") from None
         raise RunError(
             f"{pkg} {type_}: not a roverlab node and no file {type_!r} in package {pkg} ({folder})"
         )
-    return matches[0], None, rest
+    if len(found) > 1:  # rosrun asks which one; roslaunch refuses the node
+        raise RunError(
+            f"{pkg} {type_}: multiple files named [{type_}] in package [{pkg}]: "
+            f"{', '.join(str(p) for p in found)} (run one by its path: roverlab run PATH)"
+        )
+    script = found[0]
+    if not is_python_script(script):
+        raise RunError(
+            f"{pkg} {type_}: {script} is not a Python script (roverlab runs rospy scripts, "
+            "not compiled nodes)"
+        )
+    if not os.access(script, os.X_OK):  # rosrun: "Couldn't find executable named ..."
+        typer.echo(
+            f"note: {script} is not executable (rosrun refuses it; chmod +x it for ROS): "
+            "run anyway",
+            err=True,
+        )
+    return script
 
 
 def run(

@@ -46,17 +46,19 @@ _TIMEOUT_SIGINT_S = 15.0
 _TIMEOUT_SIGTERM_S = 2.0
 
 
-def find_scripts(spec: NodeSpec, package_path: tuple[str, ...] = ()) -> list[Path]:
-    """The files named ``spec.type`` in package ``spec.pkg`` (searched through the
-    package's folders, as roslaunch finds a node's executable): one to run; none, or
-    several (roslaunch's "multiple files named"), to report."""
+def find_scripts(pkg: str, type_: str, package_path: tuple[str, ...] = ()) -> list[Path]:
+    """The files named ``type_`` in package ``pkg``, searched through the package's
+    folders as roslaunch and rosrun find a node's executable (``roverlab launch``'s script
+    nodes and ``roverlab run PKG TYPE`` both look here): one to run; none (an unknown
+    package too), or several (roslaunch's "multiple files named"), to report. The
+    executable bit is not required: the callers note a file without it."""
     try:
-        folder = find_package(spec.pkg, package_path)
+        folder = find_package(pkg, package_path)
     except DescriptionError:
         return []
-    if "/" in spec.type or not spec.type:
+    if "/" in type_ or not type_:
         return []
-    return sorted(p for p in folder.rglob(spec.type) if p.is_file())
+    return sorted(p for p in folder.rglob(type_) if p.is_file())
 
 
 def is_python_script(path: Path) -> bool:

@@ -122,7 +122,7 @@ class Launch:
         process of its own (as ``roverlab run``), else skipped with a warning."""
         assert self.state is not None
         what = f"{node_spec.source}: node {node_spec.pkg}/{node_spec.type}"
-        found = find_scripts(node_spec)
+        found = find_scripts(node_spec.pkg, node_spec.type)
         if not found:
             self.state.warnings.append(
                 f"{what} is not part of roverlab and package {node_spec.pkg} has no "

@@ -1,12 +1,17 @@
 """``DashboardServer``: rviz in the browser, served by FastAPI + uvicorn in one thread.
 
-One page (``static/index.html`` + ``static/app.js``, no build step) and one websocket at
-``/ws``. The server pushes each display's binary frame (map or map patch, points, poses,
-path, camera image; see :mod:`roverlab.viz.protocol`) only when its data changed, marker
-lists as JSON ``{"type": "markers", "slot", "items"}``, the configuration as JSON
-``{"type": "config", "config"}`` whenever it changes, and a JSON ``state`` message (frames,
-robot outline, status tree; the topic list with rates once a second) at
-:attr:`DashboardServer.state_rate_hz`.
+One page, no build step: ``static/index.html`` and its scripts, in the order it loads them:
+``redraw.js`` (when the views draw: only on change), ``panel.js`` (the side panels),
+``view2d.js`` (the 2D view and its tools), ``app.js`` (the websocket, the data it brings,
+``window.viz``), then the 3D view's modules ``view3d.js`` (renderer and cameras),
+``displays3d.js`` (each display's objects in the scene) and ``markers3d.js`` (markers), on
+three.js in ``static/vendor``; its icon is ``static/favicon.svg`` (also at
+``/favicon.ico``). One websocket at ``/ws``: the server pushes each display's binary frame
+(map or map patch, points, poses, path, camera image; see :mod:`roverlab.viz.protocol`)
+only when its data changed, marker lists as JSON ``{"type": "markers", "slot", "items"}``,
+the configuration as JSON ``{"type": "config", "config"}`` whenever it changes, and a JSON
+``state`` message (frames, robot outline, status tree; the topic list with rates once a
+second) at :attr:`DashboardServer.state_rate_hz`.
 
 The page sends JSON back: tools ``{"type": "goal" | "initialpose", "x", "y", "yaw"}``,
 ``{"type": "point", "x", "y"}``; joint sliders ``{"type": "joint", "name", "position"}``;
@@ -19,8 +24,10 @@ to a save come back as ``{"type": "notice", "level", "text"}``.
 The configuration is shared by every page of one server (like one rviz window).
 
 Security: on a loopback host no token is needed. Any other host requires a token (made up
-and printed once when not given), asked for by the page URL (``/?token=...``) and the
-websocket (``/ws?token=...``); a wrong one gets HTTP 403.
+and printed once when not given), asked for by the page URL (``/?token=...``), the
+websocket (``/ws?token=...``), ``/config`` and ``/mesh/N`` (the page adds its own token:
+``viz.withToken`` of app.js); a wrong one gets HTTP 403. The static files and the icon are
+public.
 """
 
 from __future__ import annotations
@@ -187,6 +194,11 @@ class DashboardServer:
             if not path.is_file():
                 return PlainTextResponse(f"{uri}: no such file {path}", status_code=404)
             return FileResponse(path)
+
+        @app.get("/favicon.ico")
+        def favicon() -> Response:
+            """The icon, for a browser that asks before (or without) reading the page."""
+            return FileResponse(STATIC_DIR / "favicon.svg", media_type="image/svg+xml")
 
         app.mount("/static", StaticFiles(directory=STATIC_DIR), name="static")
 

@@ -35,10 +35,12 @@
   }
 
   // ------------------------------------------------------------------ socket
+  // the page's ?token= (a dashboard off loopback asks for it on /ws, /config and /mesh/N),
+  // added to a request of the server's; displays3d.js fetches meshes through viz.withToken
   const token = new URLSearchParams(location.search).get("token");
-  const q = token ? "?token=" + encodeURIComponent(token) : "";
-  $("download-config").href = "config" + q;
-  const wsUrl = (location.protocol === "https:" ? "wss://" : "ws://") + location.host + "/ws" + q;
+  const withToken = (path) => (token ? path + "?token=" + encodeURIComponent(token) : path);
+  $("download-config").href = withToken("config");
+  const wsUrl = (location.protocol === "https:" ? "wss://" : "ws://") + location.host + withToken("/ws");
   let ws = null, retries = 0, retryTimer = null;
   const conn = { connected: false, attempts: 0 };
   function send(obj) { if (ws && ws.readyState === 1) ws.send(JSON.stringify(obj)); }
@@ -261,7 +263,7 @@
 
   // view: setting a property through it asks for a frame (redraw.watch)
   window.viz = { view: redraw.watch(view), data, conn, worldToScreen, screenToWorld, setTool, send, PALETTES,
-                 configHooks, getTool, framePose, redraw, requestDraw, expirePoints };
+                 configHooks, getTool, framePose, redraw, requestDraw, expirePoints, withToken };
   connect();
   requestDraw();
 })();

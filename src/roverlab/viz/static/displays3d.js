@@ -199,14 +199,13 @@ function updatePoints(slot, d, L) {
 }
 
 // URDF mesh visuals: STL (in the URDF material's colour) and COLLADA (its own materials),
-// fetched from the dashboard's /mesh/<visual index>, the files of the loaded model only
-const token = new URLSearchParams(location.search).get("token");
-const meshQuery = token ? "?token=" + encodeURIComponent(token) : "";
+// fetched from the dashboard's /mesh/<visual index> (with the page's token: viz.withToken),
+// the files of the loaded model only
 viz.meshes = { loaded: 0, failed: 0 };
 function loadMesh(index, geometry, rgba, alpha) {
   const holder = new THREE.Group();
   holder.scale.set(...geometry.scale);
-  const url = `mesh/${index}${meshQuery}`, name = geometry.filename.toLowerCase();
+  const url = viz.withToken(`mesh/${index}`), name = geometry.filename.toLowerCase();
   const a = rgba[3] * alpha;
   const done = (obj) => { holder.add(obj); viz.meshes.loaded += 1; requestDraw(); };
   const fail = (err) => { viz.meshes.failed += 1; console.warn("mesh", geometry.filename, err); };
