@@ -75,6 +75,24 @@ def test_the_kernel_never_sweeps_a_spinning_bar_through_a_wall(
     assert abs(st[S_TH]) < 0.5 * math.pi  # ... before the bar's end could pass it
 
 
+@pytest.mark.parametrize("kind", [DRIVE_DIFF, DRIVE_HOLONOMIC])
+def test_more_than_half_a_turn_per_step_turns_the_commanded_way(kind: float) -> None:
+    """4 rad in one 0.1 s step: the sub-steps follow the turn (not its wrapped -2.28 rad),
+    so the bar meets the wall turning counter-clockwise, as commanded."""
+    walls = np.array([[-3.0, 0.41, 3.0, 0.41]])
+    st = np.zeros(STATE_SIZE)
+    if kind == DRIVE_DIFF:
+        st[S_TL], st[S_TR] = -0.5 * 40.0 * SEP, 0.5 * 40.0 * SEP
+    else:
+        st[S_CW] = 40.0
+    params = np.array([SEP, 0.05, 0.0, 0.0, inner_radius(BAR), kind])
+    near = np.zeros(1, dtype=np.int64)
+    advance(st, params, 0.1, BAR, walls, np.zeros((0, 3)), near, np.zeros((4, 2)), 0, 1)
+    assert st[S_CONTACT] == 1.0
+    assert 1.0 < st[S_TH] < 0.5 * math.pi
+    assert _swept_reach(BAR, 0.0, st[S_TH]) <= 0.41
+
+
 def _bar_robot(plugin: str) -> Any:
     """The bar as a URDF box body with a drive ``plugin``'s ``<gazebo>`` block."""
     joints = "".join(
