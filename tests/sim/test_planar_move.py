@@ -123,6 +123,25 @@ def test_odometry_is_the_true_pose_with_base_frame_velocities() -> None:
     assert odom[-1].pose.covariance[0] == 1e-5 and not odom[-1].twist.covariance.any()
 
 
+def test_ground_truth_twist_is_the_world_velocity_as_p3d() -> None:
+    """Strafing while turning: the ground truth's twist is the world-frame velocity (as
+    gazebo_ros_p3d's), the central difference of its poses."""
+    ctx = Context()
+    Simulation(context=ctx, world=_EMPTY, robot=_omni(), spawn=SpawnPose(0.5, 0.5, 1.0))
+    got = _collect(ctx, {"/ground_truth/state": "nav_msgs/msg/Odometry"})
+    _drive(ctx, linear_x=0.1, linear_y=-0.3, angular_z=0.8)
+    ctx.spin_for(3.0)
+    msgs = got["/ground_truth/state"][2:]
+    for before, m, after in zip(msgs, msgs[1:], msgs[2:], strict=False):
+        dt = (time_to_ns(after.header.stamp) - time_to_ns(before.header.stamp)) / 1e9
+        p, q = before.pose.pose.position, after.pose.pose.position
+        t = m.twist.twist
+        assert (t.linear.x, t.linear.y) == pytest.approx(
+            ((q.x - p.x) / dt, (q.y - p.y) / dt), abs=1e-4
+        )
+        assert t.angular.z == pytest.approx(0.8, abs=1e-9)
+
+
 def _odom_tf_pairs(plugin: str) -> set[tuple[str, str]]:
     ctx = Context()
     Simulation(context=ctx, world=_EMPTY, robot=_omni(plugin))

@@ -12,6 +12,7 @@ import pytest
 from PIL import Image
 
 from roverlab.core import Context
+from roverlab.geometry import wrap_angle
 from roverlab.msgs import Twist, image_to_array, pointcloud2_to_xyz, time_to_ns
 from roverlab.raycast.lidar import cast_2d
 from roverlab.sim.app import Simulation, SimulationError
@@ -98,6 +99,39 @@ def test_world_odometry_equals_ground_truth_and_tf() -> None:
     last = got["/odom"][-1][1]
     assert last.header.frame_id == "odom" and last.child_frame_id == "base_footprint"
     assert math.hypot(last.pose.pose.position.x + 1, last.pose.pose.position.y + 1) > 0.5
+
+
+def _yaw(odom: Any) -> float:
+    q = odom.pose.pose.orientation
+    return 2.0 * math.atan2(q.z, q.w)
+
+
+def test_ground_truth_twist_is_the_world_velocity_as_p3d() -> None:
+    """gazebo_ros_p3d publishes the link's world-frame velocity (not the child frame's, as
+    nav_msgs/Odometry would have it): driving forward while turning, the twist equals the
+    central difference of the published poses."""
+    ctx = Context()
+    Simulation(
+        context=ctx, world=_room(), robot="mybot", spawn=SpawnPose(-1.0, -1.0, 0.3),
+        parameters={"wheel_slip": 0.0},
+    )  # fmt: skip
+    got = _collect(ctx, {"/ground_truth/state": "nav_msgs/msg/Odometry"})
+    cmd = ctx.create_node("driver").create_publisher(Twist, "/cmd_vel", 1)
+    cmd.publish(Twist(linear_x=0.3, angular_z=0.5))
+    ctx.spin_for(6.0)
+    msgs = [m for _, m in got["/ground_truth/state"]][50:]  # after the wheels' ramp
+    assert msgs[0].header.frame_id == "world"
+    for before, m, after in zip(msgs, msgs[1:], msgs[2:], strict=False):
+        dt = (time_to_ns(after.header.stamp) - time_to_ns(before.header.stamp)) / 1e9
+        p, q = before.pose.pose, after.pose.pose
+        vx = (q.position.x - p.position.x) / dt
+        vy = (q.position.y - p.position.y) / dt
+        turn = float(wrap_angle(_yaw(after) - _yaw(before)))
+        t = m.twist.twist
+        assert (t.linear.x, t.linear.y) == pytest.approx((vx, vy), abs=1e-4)
+        assert t.angular.z == pytest.approx(turn / dt, abs=1e-6)
+    headings = [_yaw(m) for m in msgs]
+    assert max(headings) - min(headings) > 2.0  # it turned: a body-frame twist would differ
 
 
 def test_a_late_tf_reader_gets_the_odometry_and_wheel_transforms() -> None:

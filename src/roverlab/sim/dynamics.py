@@ -233,12 +233,18 @@ def advance(
         contact = False
         if v != 0.0 or w != 0.0 or vy != 0.0:
             dist = math.hypot(gx - x0, gy - y0)
+            dth = _wrap(gth - th0)
+            if abs(w * dt) >= math.pi:  # more than half a turn in one step: not wrapped
+                dth = w * dt
+            _cover(state, x0, y0, dist, footprint, segments, circles, near)
+            # sub-steps: the origin moves at most half the inscribed radius in each, and
+            # the farthest footprint point (state[S_RADIUS] from the origin) turns at most
+            # as far, so a fast spin cannot sweep a corner through a wall
+            sweep = max(dist, state[S_RADIUS] * abs(dth))
             n = 1
             if inner > 0.0:
-                n = max(1, int(math.ceil(dist / (0.5 * inner))))
-            dth = _wrap(gth - th0)
-            _cover(state, x0, y0, dist, footprint, segments, circles, near)
-            px, py = x0, y0
+                n = max(1, int(math.ceil(sweep / (0.5 * inner))))
+            px, py, pth = x0, y0, th0
             for k in range(1, n + 1):
                 f = k / n
                 cx = x0 + f * (gx - x0)
@@ -248,7 +254,7 @@ def advance(
                     contact = True
                     th = cth
                     if _hits(footprint, px, py, cth, segments, circles, buf, near, state):
-                        th = th0
+                        th = pth  # the last clear sub-step's heading (clear at px, py)
                     lo, hi = 0.0, 1.0
                     for _ in range(8):
                         mid = 0.5 * (lo + hi)
@@ -270,7 +276,7 @@ def advance(
                     gy = py + lo * (cy - py)
                     gth = th
                     break
-                px, py = cx, cy
+                px, py, pth = cx, cy, cth
         if contact:
             if holonomic:  # what the body did move, in its frame at the step's start
                 c, s = math.cos(th0), math.sin(th0)

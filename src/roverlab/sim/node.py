@@ -102,9 +102,10 @@ class SimulatorNode(Node):
 
     Publishes what the robot's Gazebo plugins would: odometry and the odom -> base
     transform (diff drive, skid steer or planar move), scans, IMU, camera and depth
-    images and point clouds; plus the ground-truth pose on ``/ground_truth/state``
-    (nav_msgs/Odometry in the ``world`` frame, like the p3d plugin). ``/clock`` comes
-    from the context.
+    images and point clouds; plus the ground truth on ``/ground_truth/state``
+    (nav_msgs/Odometry in the ``world`` frame, like the p3d plugin: the pose and, as p3d,
+    the twist in the world frame too, not the child frame). ``/clock`` comes from the
+    context.
 
     Parameters: ``seed`` (int), ``physics_rate`` (Hz, default 100), ``wheel_slip``
     (relative 1-sigma slip per wheel and step, default 0.02; acts on encoder odometry
@@ -363,15 +364,17 @@ class SimulatorNode(Node):
             )
 
     def _publish_ground_truth(self) -> None:
+        # as gazebo_ros_p3d: the twist in the world frame (the link's world velocity)
         self.advance()
         sec, nsec = divmod(self._executor.now_ns, 1_000_000_000)
-        half = 0.5 * self.yaw
+        yaw, v, vy = self.yaw, self.v, self.vy
+        c, s = math.cos(yaw), math.sin(yaw)
         zero = np.zeros(36)
         self.gt_pub.publish(
             build.odometry(
                 sec, nsec, "world", self.robot.base_frame, self.x, self.y, 0.0,
-                0.0, 0.0, math.sin(half), math.cos(half), zero,
-                self.v, self.vy, 0.0, 0.0, 0.0, self.w, zero,
+                0.0, 0.0, math.sin(0.5 * yaw), math.cos(0.5 * yaw), zero,
+                c * v - s * vy, s * v + c * vy, 0.0, 0.0, 0.0, self.w, zero,
             )
         )  # fmt: skip
 
