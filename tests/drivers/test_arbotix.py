@@ -146,6 +146,7 @@ def test_nan_command_is_ignored_and_sim_false_is_skipped(
     launch_file = tmp_path / "a.launch"
     launch_file.write_text(
         f"""<launch>
+  <arg name="sim" default="true"/>
   <node name="arbotix" pkg="arbotix_python" type="arbotix_driver">
     <rosparam file="{URDLEE}/config/control.yaml" command="load"/>
     <param name="sim" value="$(arg sim)"/>
