@@ -5,7 +5,6 @@ plugins' own defaults and simulated (the planar move's simulation: tests/sim).""
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 import pytest
 
@@ -16,6 +15,7 @@ from roverlab.msgs import Twist
 from roverlab.sim.app import Simulation
 from roverlab.sim.robot import sim_config_from_model
 from roverlab.world.yaml_world import world_from_dict
+from tests.helpers.nodes import collect
 
 _INERTIA = '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/>'
 
@@ -89,21 +89,13 @@ def test_skid_steer_torque_of_four_wheels_limits_the_acceleration() -> None:
     assert config.drive.publish_odom_tf is False
 
 
-def _collect(ctx: Context, topics: dict[str, str]) -> dict[str, list[Any]]:
-    got: dict[str, list[Any]] = {t: [] for t in topics}
-    node = ctx.create_node("collector")
-    for topic, typ in topics.items():
-        node.create_subscription(typ, topic, lambda m, t=topic: got[t].append(m), 1000)
-    return got
-
-
 _EMPTY = world_from_dict({"name": "empty"}, source=Path("empty.yaml"))
 
 
 def test_a_skid_steer_robot_drives_on_cmd_vel() -> None:
     ctx = Context()
     Simulation(context=ctx, world=_EMPTY, robot=load_robot(_skid(_HUSKY_LIKE)))
-    got = _collect(ctx, {"/odom": "nav_msgs/msg/Odometry", "/tf": "tf2_msgs/msg/TFMessage"})
+    got = collect(ctx, {"/odom": "nav_msgs/msg/Odometry", "/tf": "tf2_msgs/msg/TFMessage"})
     ctx.create_node("driver").create_publisher(Twist, "/cmd_vel", 1).publish(Twist(linear_x=0.5))
     ctx.spin_for(2.0)
     assert len(got["/odom"]) == pytest.approx(200, abs=2)  # updateRate 100
@@ -169,7 +161,7 @@ def test_the_imu_sensor_plugin_publishes_in_the_simulator() -> None:
     )
     ctx = Context()
     Simulation(context=ctx, world=_EMPTY, robot=robot)
-    got = _collect(ctx, {"/imu": "sensor_msgs/msg/Imu"})
+    got = collect(ctx, {"/imu": "sensor_msgs/msg/Imu"})
     ctx.spin_for(2.0)
     assert len(got["/imu"]) == pytest.approx(40, abs=1)
     assert got["/imu"][-1].header.frame_id == "imu_link"

@@ -33,6 +33,7 @@ from roverlab.sim.dynamics import (
 )
 from roverlab.sim.node import SpawnPose
 from roverlab.world.yaml_world import world_from_dict
+from tests.helpers.nodes import collect
 
 _EMPTY = world_from_dict({"name": "empty"}, source=Path("empty.yaml"))
 # a wall along y = 1 (its face towards the robot at y = 0.95)
@@ -52,14 +53,6 @@ def _omni(plugin: str = "", extra: str = "") -> Any:
         f'<gazebo><plugin name="omni" filename="libgazebo_ros_planar_move.so">{plugin}'
         f"</plugin>{extra}</gazebo></robot>"
     )
-
-
-def _collect(ctx: Context, topics: dict[str, str]) -> dict[str, list[Any]]:
-    got: dict[str, list[Any]] = {t: [] for t in topics}
-    node = ctx.create_node("collector")
-    for topic, typ in topics.items():
-        node.create_subscription(typ, topic, lambda m, t=topic: got[t].append(m), 1000)
-    return got
 
 
 def _drive(ctx: Context, **twist: float) -> Any:
@@ -98,7 +91,7 @@ def test_a_body_twist_is_followed_exactly_while_turning() -> None:
 def test_odometry_is_the_true_pose_with_base_frame_velocities() -> None:
     ctx = Context()
     sim = Simulation(context=ctx, world=_EMPTY, robot=_omni(), spawn=SpawnPose(0.5, 0.5, 1.0))
-    got = _collect(
+    got = collect(
         ctx, {"/odom": "nav_msgs/msg/Odometry", "/ground_truth/state": "nav_msgs/msg/Odometry"}
     )
     _drive(ctx, linear_x=0.1, linear_y=-0.3, angular_z=0.4)
@@ -128,7 +121,7 @@ def test_ground_truth_twist_is_the_world_velocity_as_p3d() -> None:
     gazebo_ros_p3d's), the central difference of its poses."""
     ctx = Context()
     Simulation(context=ctx, world=_EMPTY, robot=_omni(), spawn=SpawnPose(0.5, 0.5, 1.0))
-    got = _collect(ctx, {"/ground_truth/state": "nav_msgs/msg/Odometry"})
+    got = collect(ctx, {"/ground_truth/state": "nav_msgs/msg/Odometry"})
     _drive(ctx, linear_x=0.1, linear_y=-0.3, angular_z=0.8)
     ctx.spin_for(3.0)
     msgs = got["/ground_truth/state"][2:]
@@ -145,7 +138,7 @@ def test_ground_truth_twist_is_the_world_velocity_as_p3d() -> None:
 def _odom_tf_pairs(plugin: str) -> set[tuple[str, str]]:
     ctx = Context()
     Simulation(context=ctx, world=_EMPTY, robot=_omni(plugin))
-    got = _collect(ctx, {"/tf": "tf2_msgs/msg/TFMessage"})
+    got = collect(ctx, {"/tf": "tf2_msgs/msg/TFMessage"})
     _drive(ctx, linear_y=0.2)
     ctx.spin_for(0.5)
     return {(t.header.frame_id, t.child_frame_id) for m in got["/tf"] for t in m.transforms}
@@ -163,7 +156,7 @@ def test_the_odom_transform_is_broadcast_unless_switched_off() -> None:
 def test_no_odometry_at_rate_zero() -> None:
     ctx = Context()
     Simulation(context=ctx, world=_EMPTY, robot=_omni("<odometryRate>0</odometryRate>"))
-    got = _collect(ctx, {"/odom": "nav_msgs/msg/Odometry", "/tf": "tf2_msgs/msg/TFMessage"})
+    got = collect(ctx, {"/odom": "nav_msgs/msg/Odometry", "/tf": "tf2_msgs/msg/TFMessage"})
     ctx.spin_for(1.0)
     assert got["/odom"] == []
     assert not [t for m in got["/tf"] for t in m.transforms if t.header.frame_id == "odom"]
@@ -194,7 +187,7 @@ def test_without_cmd_timeout_the_last_command_holds() -> None:
 def test_a_wall_stops_the_sideways_motion() -> None:
     ctx = Context()
     sim = Simulation(context=ctx, world=_WALL, robot=_omni())
-    got = _collect(ctx, {"/odom": "nav_msgs/msg/Odometry"})
+    got = collect(ctx, {"/odom": "nav_msgs/msg/Odometry"})
     pub = _drive(ctx, linear_y=0.5)
     ctx.spin_for(4.0)
     s = sim.simulator
@@ -236,7 +229,7 @@ def test_the_imu_of_a_strafing_turning_body_feels_the_rotating_frame() -> None:
     )
     ctx = Context()
     Simulation(context=ctx, world=_EMPTY, robot=_omni(extra=imu))
-    got = _collect(ctx, {"/imu": "sensor_msgs/msg/Imu"})
+    got = collect(ctx, {"/imu": "sensor_msgs/msg/Imu"})
     _drive(ctx, linear_x=0.3, linear_y=0.2, angular_z=0.5)
     ctx.spin_for(1.0)
     last = got["/imu"][-1]
