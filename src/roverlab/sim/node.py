@@ -110,7 +110,8 @@ class SimulatorNode(Node):
     Parameters: ``seed`` (int), ``physics_rate`` (Hz, default 100), ``wheel_slip``
     (relative 1-sigma slip per wheel and step, default 0.02: the ground moves the body a
     little differently from what the wheels turned, so odometry from the encoders drifts
-    from the true pose; ``world`` odometry is the true pose), ``ground_truth_rate`` (Hz, default 50), ``ground_truth_topic``.
+    from the true pose; ``world`` odometry is the true pose), ``ground_truth_rate`` (Hz,
+    default 50), ``ground_truth_topic``.
     """
 
     def __init__(
