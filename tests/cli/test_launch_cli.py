@@ -109,3 +109,37 @@ def test_a_launch_with_driver_nodes_runs_on_wall_time(tmp_path: Path) -> None:
     ):
         mode, note = choose_clock(load_launch(find_package(pkg) / launch_file), "auto", 1.0)
         assert mode == "wall" and "driver nodes" in note
+
+
+def test_only_nodes_that_run_as_scripts_open_the_script_endpoint(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capfd: pytest.CaptureFixture[str]
+) -> None:
+    """A node whose type names several files or a compiled one is skipped by the runner, so
+    it neither exposes the launch (``--rate max`` stays private) nor opens the socket."""
+    from roverlab.cli import launch as launch_cli
+    from tests.helpers.nodes import run_main
+
+    pkg = tmp_path / "ws" / "my_pkg"
+    for sub in ("scripts", "nodes"):
+        (pkg / sub).mkdir(parents=True)
+        (pkg / sub / "twice.py").write_text("print('ran')\n")
+    (pkg / "package.xml").write_text("<package><name>my_pkg</name></package>")
+    (pkg / "nodes" / "driver_node").write_bytes(b"\x7fELF\x02\x01\x01")
+    monkeypatch.setenv("ROS_PACKAGE_PATH", str(tmp_path / "ws"))
+    path = _launch(
+        tmp_path,
+        '<node pkg="my_pkg" type="twice.py" name="a"/>'
+        '<node pkg="my_pkg" type="driver_node" name="b"/>',
+    )
+    asked: list[tuple[bool | None, tuple[str, ...]]] = []
+
+    def expose_if_asked(ctx: object, context: object, expose: bool | None, pace: float, *,
+                        also_listen: tuple[str, ...] = ()) -> None:  # fmt: skip
+        asked.append((expose, also_listen))
+
+    monkeypatch.setattr(launch_cli, "expose_if_asked", expose_if_asked)
+    argv = ["launch", str(path), "--rate", "max", "--clock", "wall", "--duration", "0.05"]
+    assert run_main(argv) == 0
+    assert asked == [(None, ())]
+    err = capfd.readouterr().err
+    assert "multiple files named [twice.py]" in err and "driver_node is not a Python" in err

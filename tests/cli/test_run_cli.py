@@ -103,6 +103,15 @@ def test_run_refuses_an_ambiguous_or_compiled_package_script(
     (line,) = err.strip().splitlines()
     assert "multiple files named [twice.py] in package [hello_pkg]" in line
     assert str(pkg / "nodes" / "twice.py") in line and str(pkg / "scripts" / "twice.py") in line
+    assert line.endswith("(name one by its path in the package: nodes/twice.py)")
+    # rosrun's PKG PATH: a path inside the package names one file; one leaving it is refused
+    assert run_main(["run", "hello_pkg", "scripts/twice.py"]) == 0
+    assert capfd.readouterr().out == "ran\n"
+    assert run_main(["run", "hello_pkg", "scripts/../../hello_pkg/nodes/twice.py"]) == 2
+    (line,) = capfd.readouterr().err.strip().splitlines()
+    assert line.endswith(
+        f"'scripts/../../hello_pkg/nodes/twice.py' is outside package hello_pkg ({pkg})"
+    )
     assert run_main(["run", "hello_pkg", "driver_node"]) == 2
     (line,) = capfd.readouterr().err.strip().splitlines()
     assert f"{pkg / 'nodes' / 'driver_node'} is not a Python script" in line
@@ -112,7 +121,7 @@ def test_run_refuses_an_ambiguous_or_compiled_package_script(
     ("args", "needle"),
     [
         (["no_such_script.py"], "no_such_script.py: no such file"),
-        (["no_such_pkg", "thing"], "not a roverlab node, and"),
+        (["no_such_pkg", "thing"], "not a roverlab node, and package 'no_such_pkg' not found"),
         (["mbot_navigation", "nothing.py"], "no file 'nothing.py' in package mbot_navigation"),
         (["--clock", "sometimes", "map_server", "map_server", "x.yaml"], "unknown --clock"),
     ],

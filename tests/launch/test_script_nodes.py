@@ -138,6 +138,7 @@ def test_scripts_that_cannot_run_are_named(
   <node pkg="my_pkg" type="driver_node" name="driver"/>
   <node pkg="my_pkg" type="nothing.py" name="nothing"/>
   <node pkg="other_pkg" type="x.py" name="x"/>
+  <node pkg="my_pkg" type="../my_pkg/scripts/talker.py" name="up"/>
 </launch>""")  # fmt: skip
     monkeypatch.setenv("ROS_PACKAGE_PATH", str(path.parents[2]))
     ctx = _context()
@@ -146,10 +147,14 @@ def test_scripts_that_cannot_run_are_named(
     finally:
         ctx.shutdown()
     assert launch.processes == {}
-    driver, nothing, other = launch.warnings
+    driver, nothing, other, up = launch.warnings
     assert str(path) in driver and "driver_node is not a Python script" in driver
-    assert "package my_pkg has no script 'nothing.py'; skipped" in nothing
-    assert "other_pkg/x.py is not part of roverlab" in other
+    assert "my_pkg/nothing.py is not part of roverlab, and no file 'nothing.py' in " in nothing
+    assert nothing.endswith(f"package my_pkg ({path.parents[1]}); skipped")
+    # the package itself missing: said so, with where it was looked for
+    assert "other_pkg/x.py is not part of roverlab, and package 'other_pkg' not found " in other
+    assert f"(searched: {path.parents[2]}" in other
+    assert "'../my_pkg/scripts/talker.py' is outside package my_pkg" in up
     private = Context(clock="wall", publish_clock=False)  # no transport: the script is alone
     try:
         path.write_text(TALK.format(extra="", out=tmp_path / "x.json"))
@@ -165,10 +170,12 @@ def test_an_ambiguous_script_is_refused_and_a_non_executable_one_noted(
     path = _package(tmp_path, """<launch>
   <node pkg="my_pkg" type="talker.py" name="talker"/>
   <node pkg="my_pkg" type="once.py" name="once"/>
+  <node pkg="my_pkg" type="nodes/talker.py" name="by_path"/>
 </launch>""")  # fmt: skip
     scripts = path.parents[1] / "scripts"
     (path.parents[1] / "nodes").mkdir()
     (path.parents[1] / "nodes" / "talker.py").write_text(SCRIPT)  # a second talker.py
+    (path.parents[1] / "nodes" / "talker.py").chmod(0o755)
     (scripts / "once.py").write_text("print('once')\n")  # mode 0644: forgot chmod +x
     monkeypatch.setenv("ROS_PACKAGE_PATH", str(path.parents[2]))
     monkeypatch.setenv("ROS_HOME", str(tmp_path / "ros_home"))
@@ -180,7 +187,10 @@ def test_an_ambiguous_script_is_refused_and_a_non_executable_one_noted(
     (ambiguous,) = launch.warnings
     assert ambiguous.startswith(f'{path}: <node name="talker">: node my_pkg/talker.py: ')
     assert "multiple files named [talker.py] in package [my_pkg]" in ambiguous
-    assert list(launch.processes) == ["/once"]
+    assert "(name one by its path in the package: nodes/talker.py)" in ambiguous
+    # a path inside the package names one file, as rosrun takes it
+    assert list(launch.processes) == ["/once", "/by_path"]
+    assert launch.processes["/by_path"][1].script == path.parents[1] / "nodes" / "talker.py"
     (note,) = launch.notes
     assert f"{scripts / 'once.py'} is not executable (roslaunch refuses it" in note
     assert note.startswith(f"{path}: ") and note.endswith("run anyway")

@@ -23,7 +23,7 @@ from roverlab.cli.sim import parse_rate
 from roverlab.core import Context, configure_logging
 from roverlab.description import find_package
 from roverlab.launch import REGISTRY, LaunchError, LaunchSpec, build_launch, load_launch
-from roverlab.launch.process import find_scripts, launch_endpoint
+from roverlab.launch.process import is_script_node, launch_endpoint
 
 CLOCKS = ("auto", "sim", "external", "wall")
 _SIMULATOR_NODES = {("gazebo_ros", "gzserver"), ("gazebo_ros", "spawn_model")}
@@ -154,7 +154,7 @@ def launch(
         typer.echo(f"note: {note}", err=True)
     # the topics are exposed first: script nodes run in processes of their own
     scripts = [
-        n for n in spec.nodes if (n.pkg, n.type) not in REGISTRY and find_scripts(n.pkg, n.type)
+        n for n in spec.nodes if (n.pkg, n.type) not in REGISTRY and is_script_node(n.pkg, n.type)
     ]
     if scripts and expose is None:
         expose = True  # --rate max too: the scripts must hear the launch

@@ -11,10 +11,8 @@ import typer
 
 from roverlab.cli.common import connect_following_clock, network_options, run_context
 from roverlab.core import Context, Node, configure_logging
-from roverlab.description import find_package
-from roverlab.description.errors import DescriptionError
 from roverlab.errors import RoverlabError
-from roverlab.launch.process import find_scripts, is_python_script
+from roverlab.launch.process import ScriptLookupError, find_script
 from roverlab.launch.registry import REGISTRY, LaunchState
 from roverlab.launch.xml import NodeSpec
 from roverlab.ros1 import run_script
@@ -51,32 +49,19 @@ def _resolve(target: list[str]) -> tuple[Path | None, NodeSpec | None, list[str]
 
 
 def _package_script(pkg: str, type_: str) -> Path:
-    """The one file named ``type_`` in package ``pkg`` (``roverlab launch``'s lookup), as
-    rosrun picks it; a file without the executable bit, which rosrun refuses, is noted.
+    """The one file named ``type_`` (or at the path ``type_`` inside it) in package ``pkg``
+    (``roverlab launch``'s lookup), as rosrun picks it; a file without the executable bit,
+    which rosrun refuses, is noted.
 
     Raises:
-        RunError: no such package or file, several files of that name, not a Python script.
+        RunError: no such package or file, a path outside the package, several files of
+            that name, not a Python script.
     """
-    found = find_scripts(pkg, type_)
-    if not found:
-        try:
-            folder = find_package(pkg)
-        except DescriptionError as err:
-            raise RunError(f"{pkg} {type_}: not a roverlab node, and {err}") from None
-        raise RunError(
-            f"{pkg} {type_}: not a roverlab node and no file {type_!r} in package {pkg} ({folder})"
-        )
-    if len(found) > 1:  # rosrun asks which one; roslaunch refuses the node
-        raise RunError(
-            f"{pkg} {type_}: multiple files named [{type_}] in package [{pkg}]: "
-            f"{', '.join(str(p) for p in found)} (run one by its path: roverlab run PATH)"
-        )
-    script = found[0]
-    if not is_python_script(script):
-        raise RunError(
-            f"{pkg} {type_}: {script} is not a Python script (roverlab runs rospy scripts, "
-            "not compiled nodes)"
-        )
+    try:
+        script = find_script(pkg, type_)
+    except ScriptLookupError as err:
+        joint = " not a roverlab node, and" if err.missing else ""
+        raise RunError(f"{pkg} {type_}:{joint} {err}") from None
     if not os.access(script, os.X_OK):  # rosrun: "Couldn't find executable named ..."
         typer.echo(
             f"note: {script} is not executable (rosrun refuses it; chmod +x it for ROS): "

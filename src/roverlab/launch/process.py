@@ -32,11 +32,14 @@ from roverlab.ros1.rospy.runtime import LAUNCH_PARAMS_ENV
 
 __all__ = [
     "ChildNetwork",
+    "ScriptLookupError",
     "ScriptProcess",
     "ScriptProcesses",
     "child_network",
+    "find_script",
     "find_scripts",
     "is_python_script",
+    "is_script_node",
     "launch_endpoint",
     "ros_home",
 ]
@@ -46,19 +49,82 @@ _TIMEOUT_SIGINT_S = 15.0
 _TIMEOUT_SIGTERM_S = 2.0
 
 
+class ScriptLookupError(Exception):
+    """Why a package's ``TYPE`` gives no script to run (one line, no trailing period).
+
+    Attributes:
+        missing: neither the package nor the file exists (``TYPE`` may be a roverlab node
+            that roverlab lacks), rather than a file found that cannot run.
+    """
+
+    def __init__(self, message: str, *, missing: bool = False) -> None:
+        super().__init__(message)
+        self.missing = missing
+
+
 def find_scripts(pkg: str, type_: str, package_path: tuple[str, ...] = ()) -> list[Path]:
     """The files named ``type_`` in package ``pkg``, searched through the package's
     folders as roslaunch and rosrun find a node's executable (``roverlab launch``'s script
-    nodes and ``roverlab run PKG TYPE`` both look here): one to run; none (an unknown
-    package too), or several (roslaunch's "multiple files named"), to report. The
-    executable bit is not required: the callers note a file without it."""
+    nodes and ``roverlab run PKG TYPE`` both look here): one to run; none, or several
+    (roslaunch's "multiple files named"), to report. A ``type_`` with a ``/`` is a path
+    inside the package (``scripts/talker.py``, as rosrun takes it): that one file. The
+    executable bit is not required: the callers note a file without it.
+
+    Raises:
+        PackageNotFoundError: no such package (with the folders searched).
+        ScriptLookupError: a path that leaves the package (``..``, absolute).
+    """
+    return _files_named(find_package(pkg, package_path), pkg, type_)
+
+
+def _files_named(folder: Path, pkg: str, type_: str) -> list[Path]:
+    if not type_:
+        return []
+    if "/" in type_:
+        rel = Path(os.path.normpath(type_))
+        if rel.is_absolute() or rel.parts[:1] == ("..",):
+            raise ScriptLookupError(f"{type_!r} is outside package {pkg} ({folder})")
+        path = folder / rel
+        return [path] if path.is_file() else []
+    return sorted(p for p in folder.rglob(type_) if p.is_file())
+
+
+def find_script(pkg: str, type_: str, package_path: tuple[str, ...] = ()) -> Path:
+    """The one Python script that ``rosrun pkg type`` or ``<node pkg type>`` runs (found as
+    :func:`find_scripts` finds it): the decision ``roverlab run``, the launch's runner and
+    ``roverlab launch`` (which exposes the topics of the script nodes) share.
+
+    Raises:
+        ScriptLookupError: no such package or file (``missing``), a path outside the
+            package, several files of that name, a file that is not a Python script.
+    """
     try:
         folder = find_package(pkg, package_path)
-    except DescriptionError:
-        return []
-    if "/" in type_ or not type_:
-        return []
-    return sorted(p for p in folder.rglob(type_) if p.is_file())
+    except DescriptionError as err:  # "package 'x' not found (searched: ...)"
+        raise ScriptLookupError(str(err), missing=True) from None
+    found = _files_named(folder, pkg, type_)
+    if not found:
+        raise ScriptLookupError(f"no file {type_!r} in package {pkg} ({folder})", missing=True)
+    if len(found) > 1:  # rosrun asks which one; roslaunch refuses the node
+        raise ScriptLookupError(
+            f"multiple files named [{type_}] in package [{pkg}]: "
+            f"{', '.join(str(p) for p in found)} (name one by its path in the package: "
+            f"{found[0].relative_to(folder)})"
+        )
+    if not is_python_script(found[0]):
+        raise ScriptLookupError(
+            f"{found[0]} is not a Python script (roverlab runs rospy scripts, not compiled nodes)"
+        )
+    return found[0]
+
+
+def is_script_node(pkg: str, type_: str, package_path: tuple[str, ...] = ()) -> bool:
+    """Whether ``<node pkg type>`` runs as a script process (:func:`find_script` finds one)."""
+    try:
+        find_script(pkg, type_, package_path)
+    except ScriptLookupError:
+        return False
+    return True
 
 
 def is_python_script(path: Path) -> bool:

@@ -17,11 +17,11 @@ from roverlab.core.log import log_to_file
 from roverlab.core.transport.zenoh import ZenohTransport
 from roverlab.description.check import robot_notes, robot_warnings
 from roverlab.launch.process import (
+    ScriptLookupError,
     ScriptProcess,
     ScriptProcesses,
     child_network,
-    find_scripts,
-    is_python_script,
+    find_script,
 )
 from roverlab.launch.registry import REGISTRY, LaunchState
 from roverlab.launch.xml import LaunchError, LaunchSpec, NodeSpec, load_launch
@@ -122,25 +122,11 @@ class Launch:
         process of its own (as ``roverlab run``), else skipped with a warning."""
         assert self.state is not None
         what = f"{node_spec.source}: node {node_spec.pkg}/{node_spec.type}"
-        found = find_scripts(node_spec.pkg, node_spec.type)
-        if not found:
-            self.state.warnings.append(
-                f"{what} is not part of roverlab and package {node_spec.pkg} has no "
-                f"script {node_spec.type!r}; skipped"
-            )
-            return
-        if len(found) > 1:  # roslaunch cannot choose either
-            self.state.warnings.append(
-                f"{what}: multiple files named [{node_spec.type}] in package "
-                f"[{node_spec.pkg}]: {', '.join(str(p) for p in found)}; skipped"
-            )
-            return
-        script = found[0]
-        if not is_python_script(script):
-            self.state.warnings.append(
-                f"{what}: {script} is not a Python script (roverlab runs rospy scripts, "
-                "not compiled nodes); skipped"
-            )
+        try:
+            script = find_script(node_spec.pkg, node_spec.type)
+        except ScriptLookupError as err:
+            joint = " is not part of roverlab, and" if err.missing else ":"
+            self.state.warnings.append(f"{what}{joint} {err}; skipped")
             return
         if not os.access(script, os.X_OK):  # roslaunch: "found but it is not executable"
             self.notes.append(
