@@ -115,6 +115,10 @@ def test_run_refuses_an_ambiguous_or_compiled_package_script(
     assert run_main(["run", "hello_pkg", "driver_node"]) == 2
     (line,) = capfd.readouterr().err.strip().splitlines()
     assert f"{pkg / 'nodes' / 'driver_node'} is not a Python script" in line
+    # the type is a file name, not a pattern (rosrun matches names exactly)
+    assert run_main(["run", "hello_pkg", "tw*.py"]) == 2
+    (line,) = capfd.readouterr().err.strip().splitlines()
+    assert "no file 'tw*.py' in package hello_pkg" in line
 
 
 @pytest.mark.parametrize(

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import glob
 import math
 import shutil
 import tempfile
@@ -91,7 +92,7 @@ def _resolve(target: list[str]) -> tuple[Path, dict[str, str]]:
         return Path(plain[0]), args
     if len(plain) == 2:
         pkg_dir = find_package(plain[0])
-        matches = sorted(pkg_dir.rglob(plain[1]))
+        matches = sorted(pkg_dir.rglob(glob.escape(plain[1])))  # the exact name, no pattern
         if not matches:
             raise LaunchError(
                 f"launch file {plain[1]!r} not found in package {plain[0]} ({pkg_dir})"

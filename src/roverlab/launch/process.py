@@ -12,6 +12,7 @@ launch's global ones reach rospy's ``get_param`` through a YAML file named by
 
 from __future__ import annotations
 
+import glob
 import os
 import shlex
 import signal
@@ -86,7 +87,7 @@ def _files_named(folder: Path, pkg: str, type_: str) -> list[Path]:
             raise ScriptLookupError(f"{type_!r} is outside package {pkg} ({folder})")
         path = folder / rel
         return [path] if path.is_file() else []
-    return sorted(p for p in folder.rglob(type_) if p.is_file())
+    return sorted(p for p in folder.rglob(glob.escape(type_)) if p.is_file())  # the exact name
 
 
 def find_script(pkg: str, type_: str, package_path: tuple[str, ...] = ()) -> Path:
