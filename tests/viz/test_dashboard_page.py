@@ -1,6 +1,6 @@
 """The dashboard page itself in Debian's chromium (Playwright): it loads with nothing
-missing (its icon included: no 404 in the console) and hands its token to the requests it
-makes of the server (``viz.withToken``)."""
+missing (its icon included: no 404 in the console), hands its token to the requests it
+makes of the server (``viz.withToken``) and reconnects when the server comes back."""
 
 from __future__ import annotations
 
@@ -13,6 +13,8 @@ import pytest
 from roverlab.core import Context
 from roverlab.viz import DashboardServer
 from tests.helpers.browser import CHROMIUM
+from tests.helpers.net import free_port
+from tests.viz.test_dashboard import VIEWPORT
 
 playwright_sync = pytest.importorskip("playwright.sync_api", reason="playwright not installed")
 pytestmark = pytest.mark.skipif(not CHROMIUM.exists(), reason="/usr/bin/chromium is absent")
@@ -71,3 +73,34 @@ def test_page_requests_carry_its_token(server: DashboardServer, browser: Any) ->
         assert status == 200
     finally:
         page.close()
+
+
+def test_page_reconnects_after_the_server_restarts(browser: Any) -> None:
+    port = free_port()
+    ctx1 = Context(clock="wall")
+    first = DashboardServer(ctx1, "127.0.0.1", port)
+    ctx1.spin_in_thread()
+    first.start()
+    pg = browser.new_page(viewport=VIEWPORT)
+    ctx2 = Context(clock="wall")
+    second = None
+    try:
+        pg.goto(first.url)
+        pg.wait_for_function("() => viz.conn.connected", timeout=10000)
+        first.stop()
+        pg.wait_for_function(
+            "() => document.getElementById('conn').textContent.includes('reconnecting')",
+            timeout=10000,
+        )
+        second = DashboardServer(ctx2, "127.0.0.1", port)
+        ctx2.spin_in_thread()
+        second.start()
+        pg.wait_for_function("() => viz.conn.connected", timeout=15000)
+        assert pg.evaluate("() => viz.conn.attempts") >= 2
+        assert pg.locator("#conn").inner_text() == "connected"
+    finally:
+        pg.close()
+        if second is not None:
+            second.stop()
+        ctx1.shutdown()
+        ctx2.shutdown()
