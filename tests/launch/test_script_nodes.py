@@ -5,6 +5,7 @@ env; stopped (its on_shutdown hooks run) with the launch; required/respawn watch
 from __future__ import annotations
 
 import json
+import tempfile
 import time
 from pathlib import Path
 
@@ -194,3 +195,63 @@ def test_an_ambiguous_script_is_refused_and_a_non_executable_one_noted(
     (note,) = launch.notes
     assert f"{scripts / 'once.py'} is not executable (roslaunch refuses it" in note
     assert note.startswith(f"{path}: ") and note.endswith("run anyway")
+
+
+SLOW_HOOK = """import os, signal, time
+import rospy
+
+out = os.environ["OUT"]
+seen = []
+rospy.init_node("slow")
+previous = signal.getsignal(signal.SIGINT)
+def count(sig, frame):  # then rospy's own handler
+    seen.append(sig)
+    previous(sig, frame)
+signal.signal(signal.SIGINT, count)
+def hook():
+    time.sleep(1.0)  # a hook that takes its time (stopping a motor, saving a file)
+    open(out, "w").write(f"signals {len(seen)}")
+rospy.on_shutdown(hook)
+open(out + ".ready", "w").write("ready")
+rospy.spin()
+"""
+
+
+def test_a_script_gets_one_sigint_and_its_slow_hook_finishes(
+    tmp_path: Path, daemon: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    out = tmp_path / "hook.txt"
+    path = _package(tmp_path, TALK.format(extra="", out=out))
+    (path.parents[1] / "scripts" / "talker.py").write_text(SLOW_HOOK)
+    monkeypatch.setenv("ROS_PACKAGE_PATH", str(path.parents[2]))
+    monkeypatch.setenv("ROS_HOME", str(tmp_path / "ros_home"))
+    ctx = _context()
+    try:
+        launch = build_launch(path, context=ctx)
+        ctx.spin_in_thread()
+        assert ctx.wait_for(lambda: Path(f"{out}.ready").exists(), timeout_sec=60)
+        (_, proc), *_ = launch.processes.values()
+        launch.stop_processes()  # as `roverlab launch` does before its network closes
+    finally:
+        ctx.shutdown()
+    assert out.read_text() == "signals 1"  # a second SIGINT cut the hook short before
+    assert proc.poll() == 0
+
+
+def test_an_unmatched_quote_in_args_is_one_launch_error(
+    tmp_path: Path, daemon: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    path = _package(tmp_path, TALK.format(extra="", out=tmp_path / "q.json"))
+    path.write_text(path.read_text().replace('args="foo bar"', 'args="foo \'bar"'))
+    monkeypatch.setenv("ROS_PACKAGE_PATH", str(path.parents[2]))
+    temp = tmp_path / "temp"
+    temp.mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", str(temp))  # where a params file would go
+    ctx = _context()
+    try:
+        quote = r"talk\.launch: <node name=.talker1.>: No closing quotation"
+        with pytest.raises(LaunchError, match=quote):
+            build_launch(path, context=ctx)
+    finally:
+        ctx.shutdown()
+    assert not list(temp.iterdir())  # no params file left behind

@@ -230,10 +230,15 @@ def stop_on_signals(
             signal.signal(s, handler)
 
 
-def run_context(context: Context, duration_s: float | None) -> float:
+def run_context(
+    context: Context,
+    duration_s: float | None,
+    before_shutdown: Callable[[], None] | None = None,
+) -> float:
     """Spin until ``duration_s`` of clock time (or forever), SIGINT / SIGTERM / SIGHUP, or
-    shutdown; then shut the context down (which finishes recordings). Returns the wall
-    seconds it ran."""
+    shutdown; then call ``before_shutdown`` (a launch stops its script processes while
+    its network still routes their last messages) and shut the context down (which
+    finishes recordings). Returns the wall seconds it ran."""
     started = time.monotonic()
     try:
         with stop_on_signals(threading.Event(), context.executor.stop):
@@ -244,7 +249,11 @@ def run_context(context: Context, duration_s: float | None) -> float:
     except KeyboardInterrupt:
         pass
     finally:
-        context.shutdown()
+        try:
+            if before_shutdown is not None:
+                before_shutdown()
+        finally:
+            context.shutdown()
     return time.monotonic() - started
 
 
@@ -279,6 +288,8 @@ def expose_if_asked(
         options = network_options(ctx)
         options = replace(options, listen=(*options.listen, *also_listen))
         context.add_transport(ZenohTransport(options.zenoh_options()))
+    elif also_listen:  # a private run: only its own script processes join it, there
+        context.add_transport(ZenohTransport(ZenohOptions(listen=also_listen, connect=())))
 
 
 class StartGuard:

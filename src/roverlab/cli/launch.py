@@ -153,12 +153,10 @@ def launch(
     mode, note = choose_clock(spec, clock, pace)
     if note:
         typer.echo(f"note: {note}", err=True)
-    # the topics are exposed first: script nodes run in processes of their own
+    # script nodes run in processes of their own, clients of this one (a private run too)
     scripts = [
         n for n in spec.nodes if (n.pkg, n.type) not in REGISTRY and is_script_node(n.pkg, n.type)
     ]
-    if scripts and expose is None:
-        expose = True  # --rate max too: the scripts must hear the launch
     context = Context(clock=mode, rate=1.0 if math.isinf(pace) else pace)
     guard = StartGuard(context)
     with _script_endpoint(bool(scripts)) as also_listen:
@@ -177,6 +175,6 @@ def launch(
         for name, (_, proc) in started.processes.items():
             typer.echo(f"started process [{name}] (pid {proc.pid}): {proc.script}", err=True)
         started.supervise()
-        wall = run_context(context, duration)
+        wall = run_context(context, duration, started.stop_processes)
     ran = "" if mode == "wall" else f"{context.now().seconds:.1f} sim s, "
     typer.echo(f"launch stopped after {ran}{wall:.1f} s wall", err=True)

@@ -222,13 +222,29 @@ class ScriptProcess:
     ) -> None:
         self.spec = spec
         self.script = script
-        self._params_file = _write_params(spec, params)
-        argv = [*shlex.split(spec.launch_prefix), sys.executable, "-m", "roverlab.cli"]
-        argv += [*network.args, "run"]
-        argv += ["--clock", clock, str(script), *shlex.split(spec.args)]
+        self._signalled: set[int] = set()
+        try:
+            argv = [*shlex.split(spec.launch_prefix), sys.executable, "-m", "roverlab.cli"]
+            argv += [*network.args, "run"]
+            argv += ["--clock", clock, str(script), *shlex.split(spec.args)]
+        except ValueError as err:  # an unmatched quote in launch-prefix or args
+            raise LaunchError(f"{spec.source}: {err}") from err
         argv += [f"{k}:={v}" for k, v in spec.remaps.items()]
         argv += [f"__name:={spec.name}", f"__ns:={spec.namespace}"]
         self.argv = argv
+        self._log: IO[bytes] | None = None
+        stdout: IO[bytes] | None = None
+        if spec.output == "log":  # roslaunch: stdout to the node's log file, stderr on screen
+            log_dir = Path(os.environ.get("ROVERLAB_LOG_DIR", Path.home() / ".roverlab" / "log"))
+            log_file = log_dir / f"{spec.name}.log"  # as the launch's own nodes' logs
+            try:
+                log_dir.mkdir(parents=True, exist_ok=True)
+                self._log = stdout = log_file.open("ab")
+            except OSError as err:
+                raise LaunchError(
+                    f"{spec.source}: cannot write {log_file}: {err.strerror}"
+                ) from err
+        self._params_file = _write_params(spec, params)
         env = {**os.environ, **spec.env, LAUNCH_PARAMS_ENV: self._params_file}
         for key, value in network.env.items():  # the launch's graph, whatever <env> says
             if value is None:
@@ -237,14 +253,12 @@ class ScriptProcess:
                 env[key] = value
         env["PYTHONUNBUFFERED"] = "1"  # its lines in order with the launch's
         cwd = script.parent if spec.cwd == "node" else ros_home()
-        self._log: IO[bytes] | None = None
-        stdout: IO[bytes] | None = None
-        if spec.output == "log":  # roslaunch: stdout to the node's log file, stderr on screen
-            log_dir = Path(os.environ.get("ROVERLAB_LOG_DIR", Path.home() / ".roverlab" / "log"))
-            log_dir.mkdir(parents=True, exist_ok=True)
-            self._log = stdout = (log_dir / f"{spec.name}.log").open("ab")
         try:
-            self.popen = subprocess.Popen(argv, env=env, cwd=cwd, stdout=stdout)
+            # a session of its own: the launch alone signals it (one SIGINT, as roslaunch
+            # sends), not also the terminal's Ctrl-C
+            self.popen = subprocess.Popen(
+                argv, env=env, cwd=cwd, stdout=stdout, start_new_session=True
+            )
         except OSError as err:
             self._cleanup()
             raise LaunchError(f"{spec.source}: cannot start {argv[0]}: {err.strerror}") from err
@@ -257,21 +271,32 @@ class ScriptProcess:
         """The exit code once the process has ended, else ``None``."""
         return self.popen.poll()
 
-    def stop(self) -> None:
-        """SIGINT (rospy's shutdown hooks run), then SIGTERM, then SIGKILL, as roslaunch."""
-        for sig, timeout_s in (
-            (signal.SIGINT, _TIMEOUT_SIGINT_S),
-            (signal.SIGTERM, _TIMEOUT_SIGTERM_S),
-            (signal.SIGKILL, None),
-        ):
-            if self.popen.poll() is not None:
-                break
+    def signal(self, sig: int) -> None:
+        """Send ``sig`` once (a second SIGINT would cut rospy's shutdown hooks short)."""
+        if sig not in self._signalled and self.popen.poll() is None:
+            self._signalled.add(sig)
             self.popen.send_signal(sig)
-            try:
-                self.popen.wait(timeout_s)
-            except subprocess.TimeoutExpired:
-                continue
-        self._cleanup()
+
+    def stop(self) -> None:
+        """SIGINT (rospy's shutdown hooks run), then SIGTERM, then SIGKILL, as roslaunch;
+        killed and its files removed whatever interrupts the wait."""
+        try:
+            for sig, timeout_s in (
+                (signal.SIGINT, _TIMEOUT_SIGINT_S),
+                (signal.SIGTERM, _TIMEOUT_SIGTERM_S),
+                (signal.SIGKILL, None),
+            ):
+                if self.popen.poll() is not None:
+                    break
+                self.signal(sig)
+                try:
+                    self.popen.wait(timeout_s)
+                except subprocess.TimeoutExpired:
+                    continue
+        finally:
+            if self.popen.poll() is None:
+                self.popen.kill()
+            self._cleanup()
 
     def _cleanup(self) -> None:
         if self._log is not None:
@@ -309,8 +334,19 @@ class ScriptProcesses:
         pass
 
     def close(self) -> None:
-        for proc in self.processes:
-            if proc.poll() is None:
-                proc.popen.send_signal(signal.SIGINT)  # all at once: their hooks run together
-        for proc in self.processes:
-            proc.stop()
+        """Stop every process (idempotent): SIGINT to all at once (their hooks run
+        together), then each waited for; whatever interrupts, none is left running."""
+        procs, self.processes = self.processes, []
+        try:
+            for proc in procs:
+                proc.signal(signal.SIGINT)
+        finally:
+            for proc in procs:
+                try:
+                    proc.stop()
+                except BaseException:
+                    for rest in procs:  # a second Ctrl-C: kill what runs, remove the files
+                        if rest.poll() is None:
+                            rest.popen.kill()
+                        rest._cleanup()
+                    raise

@@ -117,6 +117,12 @@ class Launch:
         self.running[node_spec.fq_name] = (node_spec, node)
         return node
 
+    def stop_processes(self) -> None:
+        """Stop the script processes now (before the context's network closes, so their
+        shutdown hooks' messages still travel); the context's shutdown would otherwise."""
+        if self._group is not None:
+            self._group.close()
+
     def start_script(self, node_spec: NodeSpec) -> None:
         """A ``<node>`` roverlab does not implement: the package's Python script in a
         process of its own (as ``roverlab run``), else skipped with a warning."""
