@@ -570,6 +570,7 @@ def test_models_gazebo_would_move_are_named_in_a_note(tmp_path: Path) -> None:
     falsy = box_model("ball", "4 0 0 0 0 0").replace("<static>1</static>", "<static>0</static>")
     body = (
         box_model("wall", "0 0 0 0 0 0")
+        + box_model("post", "6 0 0 0 0 0").replace("<static>1</static>", "<static>True</static>")
         + movable
         + falsy
         + "<include><uri>model://crate</uri><name>kept</name></include>"
@@ -577,7 +578,7 @@ def test_models_gazebo_would_move_are_named_in_a_note(tmp_path: Path) -> None:
         + "<model name='marker'><pose>0 0 0 0 0 0</pose><link name='l'/></model>"  # nothing to hit
     )
     w = load_sdf(write(tmp_path / "w.world", world_sdf(body)), model_path=[tmp_path / "m"])
-    assert len(w.shapes) == 5  # all kept, as fixed obstacles
+    assert len(w.shapes) == 6  # all kept, as fixed obstacles
     assert w.notes == (
         f"{tmp_path / 'w.world'}: 3 models not <static> (Gazebo lets a robot push them) kept as "
         "fixed obstacles: cart, ball, pushed",

@@ -416,7 +416,7 @@ class _SdfLoader(SdfShapeReader):
                 f"{mlabel} has <{robot_signs[0]}> elements, so it is taken for a robot: skipped",
             )
             return
-        movable = (static or _text(el.find("static"))) not in ("1", "true")
+        movable = (static or _text(el.find("static"))).lower() not in ("1", "true")
         if not label and movable and el.find(".//collision") is not None:
             self.movable.append(name)  # Gazebo's physics would move it
         if state is not None and state.pose is not None:
