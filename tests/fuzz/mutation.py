@@ -3,8 +3,11 @@ parser must pass (a result, or the project's one clear error)."""
 
 from __future__ import annotations
 
+import contextlib
 import re
-from collections.abc import Callable
+import tempfile
+from collections.abc import Callable, Iterator
+from pathlib import Path
 from typing import Any, TypeVar
 
 from hypothesis import HealthCheck, settings
@@ -90,3 +93,21 @@ def clean(fn: Callable[..., T], *args: Any, name: str | None = None, **kwargs: A
         if name is not None:
             assert name in text, f"the error does not name {name}: {text!r}"
         return None
+
+
+@contextlib.contextmanager
+def in_folder(
+    name: str, data: str | bytes, extra: dict[str, bytes] | None = None
+) -> Iterator[Path]:
+    """``data`` written to ``name`` in a fresh temporary folder (with the ``extra`` files
+    beside it), removed when the block ends: every example gets its own folder, and none
+    is left behind."""
+    with tempfile.TemporaryDirectory(prefix="roverlab-fuzz-") as folder:
+        for other, content in (extra or {}).items():
+            (Path(folder) / other).write_bytes(content)
+        path = Path(folder) / name
+        if isinstance(data, str):
+            path.write_text(data, encoding="utf-8", errors="surrogatepass")
+        else:
+            path.write_bytes(data)
+        yield path

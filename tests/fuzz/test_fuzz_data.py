@@ -4,8 +4,6 @@ tests/fuzz/mutation.py for the rule every parser must keep)."""
 
 from __future__ import annotations
 
-import tempfile
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -18,7 +16,7 @@ from roverlab.slam.data.evaluation import read_relations
 from roverlab.slam.data.logs import read_clf
 from roverlab.slam.data.posegraph import read_g2o
 from roverlab.slam.data.trajectory import read_tum
-from tests.fuzz.mutation import FUZZ, clean, mutated
+from tests.fuzz.mutation import FUZZ, clean, in_folder, mutated
 
 _RANGES = " ".join(f"{1.0 + 0.01 * i:.2f}" for i in range(180))
 CLF = (
@@ -54,35 +52,32 @@ PARAMS = (
 )
 
 
-def _file(name: str, text: str) -> Path:
-    path = Path(tempfile.mkdtemp(prefix="roverlab-fuzz-")) / name
-    path.write_text(text, encoding="utf-8", errors="surrogatepass")
-    return path
-
-
 @FUZZ
 @given(mutated(CLF))
 def test_carmen(text: str) -> None:
-    path = _file("fuzz.clf", text)
-    clean(lambda: list(read_clf(path)), name="fuzz.clf")
+    with in_folder("fuzz.clf", text) as path:
+        clean(lambda: list(read_clf(path)), name="fuzz.clf")
 
 
 @FUZZ
 @given(mutated(G2O))
 def test_g2o(text: str) -> None:
-    clean(read_g2o, _file("fuzz.g2o", text), name="fuzz.g2o")
+    with in_folder("fuzz.g2o", text) as path:
+        clean(read_g2o, path, name="fuzz.g2o")
 
 
 @FUZZ
 @given(mutated(TUM))
 def test_tum(text: str) -> None:
-    clean(read_tum, _file("fuzz.tum", text), name="fuzz.tum")
+    with in_folder("fuzz.tum", text) as path:
+        clean(read_tum, path, name="fuzz.tum")
 
 
 @FUZZ
 @given(mutated(RELATIONS))
 def test_relations(text: str) -> None:
-    clean(read_relations, _file("fuzz.relations", text), name="fuzz.relations")
+    with in_folder("fuzz.relations", text) as path:
+        clean(read_relations, path, name="fuzz.relations")
 
 
 @FUZZ
@@ -95,7 +90,8 @@ def test_message_yaml(text: str) -> None:
 @FUZZ
 @given(mutated(PARAMS))
 def test_parameter_file(text: str) -> None:
-    clean(load_parameter_file, _file("params.yaml", text), name="params.yaml")
+    with in_folder("params.yaml", text) as path:
+        clean(load_parameter_file, path, name="params.yaml")
 
 
 def _scan_bytes() -> bytes:

@@ -7,9 +7,6 @@ mutation.py), never another exception or a hang.
 
 from __future__ import annotations
 
-import tempfile
-from pathlib import Path
-
 from hypothesis import given
 from hypothesis import strategies as st
 
@@ -20,7 +17,7 @@ from roverlab.maps import load_map
 from roverlab.viz.config import parse_rviz
 from roverlab.world import load_world
 from roverlab.world.loader import BUNDLED_WORLDS_DIR
-from tests.fuzz.mutation import FUZZ, clean, mutated
+from tests.fuzz.mutation import FUZZ, clean, in_folder, mutated
 
 _MYBOT = find_package("bingda_tutorials") / "urdf" / "mybot.xacro"
 URDF_TEXT = robot_description(_MYBOT)
@@ -33,18 +30,6 @@ MAP_YAML = "image: map.pgm\nresolution: 0.05\norigin: [-1.0, -2.0, 0.0]\nnegate:
 PGM = b"P5\n4 3\n255\n" + bytes([0, 254, 205, 100, 254, 254, 0, 0, 205, 205, 254, 0])
 
 
-def _in_folder(name: str, data: str | bytes, extra: dict[str, bytes] | None = None) -> Path:
-    folder = Path(tempfile.mkdtemp(prefix="roverlab-fuzz-"))
-    for other, content in (extra or {}).items():
-        (folder / other).write_bytes(content)
-    path = folder / name
-    if isinstance(data, str):
-        path.write_text(data, encoding="utf-8", errors="surrogatepass")
-    else:
-        path.write_bytes(data)
-    return path
-
-
 @FUZZ
 @given(mutated(URDF_TEXT))
 def test_urdf(text: str) -> None:
@@ -54,22 +39,22 @@ def test_urdf(text: str) -> None:
 @FUZZ
 @given(mutated(XACRO_TEXT))
 def test_xacro(text: str) -> None:
-    path = _in_folder("robot.urdf.xacro", text)
-    clean(load_robot, path, name="robot.urdf.xacro")
+    with in_folder("robot.urdf.xacro", text) as path:
+        clean(load_robot, path, name="robot.urdf.xacro")
 
 
 @FUZZ
 @given(mutated(WORLD_TEXT))
 def test_world(text: str) -> None:
-    path = _in_folder("fuzz.world", text)
-    clean(load_world, path, name="fuzz.world")
+    with in_folder("fuzz.world", text) as path:
+        clean(load_world, path, name="fuzz.world")
 
 
 @FUZZ
 @given(mutated(LAUNCH_TEXT))
 def test_launch(text: str) -> None:
-    path = _in_folder("fuzz.launch", text)
-    clean(load_launch, path, {"simulation": "true"}, name="fuzz.launch")
+    with in_folder("fuzz.launch", text) as path:
+        clean(load_launch, path, {"simulation": "true"}, name="fuzz.launch")
 
 
 @FUZZ
@@ -81,12 +66,21 @@ def test_rviz(text: str) -> None:
 @FUZZ
 @given(mutated(MAP_YAML))
 def test_map_yaml(text: str) -> None:
-    path = _in_folder("map.yaml", text, {"map.pgm": PGM})
-    clean(load_map, path, name="map")
+    with in_folder("map.yaml", text, {"map.pgm": PGM}) as path:
+        clean(load_map, path, name="map")
 
 
 @FUZZ
 @given(st.binary(max_size=64) | st.builds(lambda cut: PGM[:cut], st.integers(0, len(PGM))))
 def test_map_image(data: bytes) -> None:
-    path = _in_folder("map.yaml", MAP_YAML, {"map.pgm": data})
-    clean(load_map, path, name="map.pgm")
+    with in_folder("map.yaml", MAP_YAML, {"map.pgm": data}) as path:
+        clean(load_map, path, name="map.pgm")
+
+
+def test_in_folder_leaves_nothing_behind() -> None:
+    # every example gets its own folder; each run of the suite used to leave hundreds in /tmp
+    with in_folder("map.yaml", MAP_YAML, {"map.pgm": PGM}) as path:
+        folder = path.parent
+        assert sorted(p.name for p in folder.iterdir()) == ["map.pgm", "map.yaml"]
+        assert path.read_text() == MAP_YAML
+    assert not folder.exists()
