@@ -91,10 +91,14 @@ class Topic:
 
     def latched_history(self) -> list[Any]:
         """Messages of transient-local publishers, oldest first, for a late subscriber."""
-        out: list[Any] = []
-        for pub in self.publishers:
-            if pub.history is not None:
-                out.extend(pub.history)
+        return [msg for _, msg in self.latched_history_numbered()]
+
+    def latched_history_numbered(self) -> list[tuple[int, Any]]:
+        """:meth:`latched_history` with each message's number in the topic's order
+        (``published`` when it was published), oldest first across publishers."""
+        # list() copies a deque atomically: another thread (Zenoh's) may read this
+        out = [entry for pub in list(self.publishers) if pub.history for entry in list(pub.history)]
+        out.sort(key=lambda entry: entry[0])
         return out
 
 

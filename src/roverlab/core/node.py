@@ -63,7 +63,11 @@ class Publisher:
         self.topic = topic
         self.topic_name = topic.name
         self.qos = qos
-        self.history: deque[Any] | None = deque(maxlen=qos.depth) if qos.latched else None
+        # a latched publisher's last messages, each with its place in the topic's order
+        # (``Topic.published`` when it was published), for late subscribers
+        self.history: deque[tuple[int, Any]] | None = (
+            deque(maxlen=qos.depth) if qos.latched else None
+        )
         self._executor = node.context.executor
 
     def publish(self, msg: Any) -> None:
@@ -87,7 +91,7 @@ class Publisher:
             q.append(msg)
             sub._ready.append((next(sub._seq), sub._take_ref))
         if self.history is not None:
-            self.history.append(msg)
+            self.history.append((topic.published, msg))
         send = topic.remote_send
         if send is not None:
             send(msg)

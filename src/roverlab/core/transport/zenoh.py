@@ -37,6 +37,15 @@ from typing import TYPE_CHECKING, Any
 import zenoh
 
 from roverlab.core.errors import ParameterError, TransportError
+from roverlab.core.transport.zenoh_graph import (
+    GraphEntity,
+    decode_name,
+    encode_name,
+    parse_graph_key,
+    query_graph,
+    query_parameters,
+)
+from roverlab.core.transport.zenoh_latched import LatchedInbox, Source, parse_tag, tag
 from roverlab.core.transport.zenoh_services import ZenohServices
 from roverlab.msgs import deserialize, serialize
 
@@ -73,15 +82,6 @@ def domain_id() -> int:
         return int(raw)
     except ValueError:
         raise TransportError(f"ROVERLAB_DOMAIN_ID must be an integer, got {raw!r}") from None
-
-
-def encode_name(name: str) -> str:
-    """A ROS name as one Zenoh key chunk ('/' -> '%')."""
-    return name.replace("/", "%")
-
-
-def decode_name(chunk: str) -> str:
-    return chunk.replace("%", "/")
 
 
 def topic_key(topic: str, domain: int = 0) -> str:
@@ -240,7 +240,8 @@ class _TopicLink:
         self.subscriber: Any = None
         self.latched_queryable: Any = None
         self.latched_watch: Any = None
-        self.remote_latched: dict[str, list[Any]] = {}  # zid -> that process's history
+        self.latched_depth = 0  # the longest history of this process's latched publishers
+        self.latched_in = LatchedInbox()  # other processes' latched messages
         self.tokens: dict[object, Any] = {}
 
 
@@ -259,6 +260,7 @@ class ZenohTransport:
         self.received = 0
         self.sent = 0
         self.dropped_wrong_type = 0
+        self.latched_repeats = 0
         self._services = ZenohServices(self)
         self._clock_watch: Any = None
         self._clock_sources: dict[str, str] = {}  # zid -> node of other /clock publishers
@@ -339,6 +341,8 @@ class ZenohTransport:
             if added:
                 if link.publisher is None:
                     self._declare_publisher(topic, link)
+                if pub.qos.latched:
+                    link.latched_depth = max(link.latched_depth, pub.qos.depth)
                 # the history's queryable before the token that makes others ask for it
                 if pub.qos.latched and link.latched_queryable is None:
                     key = f"rl/{self.domain}/l/{topic.name.lstrip('/')}/{self.zid}"
@@ -360,8 +364,10 @@ class ZenohTransport:
                     link.matching.undeclare()
                     link.publisher.undeclare()
                     link.publisher = link.matching = None
-                latched_left = any(p.history is not None for p in topic.publishers)
-                if link.latched_queryable is not None and not latched_left:
+                link.latched_depth = max(
+                    (p.qos.depth for p in topic.publishers if p.history is not None), default=0
+                )
+                if link.latched_queryable is not None and not link.latched_depth:
                     link.latched_queryable.undeclare()
                     link.latched_queryable = None
 
@@ -386,7 +392,7 @@ class ZenohTransport:
                 if link.latched_watch is None:
                     link.latched_watch = self._watch_latched(topic, link)
                 else:
-                    history = [m for msgs in link.remote_latched.values() for m in msgs]
+                    history = link.latched_in.replay()
                     ctx = self._context
                     if history and ctx is not None:
                         ctx.executor.call_soon_threadsafe(partial(_enqueue_all, [sub], history))
@@ -436,7 +442,11 @@ class ZenohTransport:
         )
 
         def send(msg: Any) -> None:
-            zpub.put(serialize(msg))
+            depth = link.latched_depth
+            if depth:  # numbered, so that a late subscriber's history query cannot reorder
+                zpub.put(serialize(msg), attachment=tag(self.zid, topic.published, depth))
+            else:
+                zpub.put(serialize(msg))
             self.sent += 1
 
         def on_matching(status: Any) -> None:
@@ -455,11 +465,13 @@ class ZenohTransport:
         # the two threads hand the GIL over once per message, not twice.
         ctx = self._context
         if ctx is not None:
+            att = sample.attachment
+            source = None if att is None else parse_tag(att.to_bytes())
             ctx.executor.call_soon_threadsafe(
-                partial(self._deliver_bytes, topic, sample.payload.to_bytes())
+                partial(self._deliver_bytes, topic, sample.payload.to_bytes(), source)
             )
 
-    def _deliver_bytes(self, topic: Any, data: bytes) -> None:
+    def _deliver_bytes(self, topic: Any, data: bytes, source: Source | None = None) -> None:
         try:
             msg = deserialize(data, topic.typename)
         except Exception:
@@ -467,13 +479,20 @@ class ZenohTransport:
             # drop, as DDS drops samples of a mismatched type
             self.dropped_wrong_type += 1
             return
+        if source is not None:
+            link = self._links.get(topic.name)
+            if link is not None and not link.latched_in.accept(source, msg):
+                self.latched_repeats += 1  # a history reply behind the live messages
+                return
         self.received += 1
         for sub in topic.subscriptions:
             sub._enqueue(msg)
 
     def _on_latched_query(self, topic: Any, query: Any) -> None:
-        for msg in topic.latched_history():
-            query.reply(query.key_expr, serialize(msg))
+        link = self._links.get(topic.name)
+        depth = max(1, link.latched_depth) if link is not None else 1
+        for number, msg in topic.latched_history_numbered():
+            query.reply(query.key_expr, serialize(msg), attachment=tag(self.zid, number, depth))
 
     def _watch_latched(self, topic: Any, link: _TopicLink) -> Any:
         """Follow the latched publishers of ``topic`` in other processes: each one that
@@ -492,18 +511,15 @@ class ZenohTransport:
             if zid == self.zid:
                 return
             selector = f"rl/{self.domain}/l/{topic.name.lstrip('/')}/{zid}"
-            link.remote_latched[zid] = []
 
             def on_reply(reply: Any) -> None:  # never block in Zenoh's callback threads
                 if reply.ok is None:
                     return
-                try:
-                    msg = deserialize(reply.ok.payload.to_bytes(), topic.typename)
-                except Exception:
-                    return
-                link.remote_latched.setdefault(zid, []).append(msg)
+                att = reply.ok.attachment
+                # an untagged reply (an older roverlab) counts as older than anything live
+                source = (None if att is None else parse_tag(att.to_bytes())) or Source(zid, 0, 1)
                 ctx.executor.call_soon_threadsafe(
-                    lambda: _enqueue_all(list(topic.subscriptions), [msg])
+                    partial(self._deliver_bytes, topic, reply.ok.payload.to_bytes(), source)
                 )
 
             self.session.get(selector, on_reply, timeout=2.0)
@@ -556,72 +572,3 @@ def _enqueue_all(subs: list[Any], msgs: list[Any]) -> None:
     for sub in subs:
         for msg in msgs:
             sub._enqueue(msg)
-
-
-# ===================================================================== graph queries
-@dataclass(frozen=True)
-class GraphEntity:
-    """One liveliness token of the graph, decoded."""
-
-    zid: str
-    kind: str  # "node", "publisher", "subscription", "service" or "client"
-    node: str
-    topic: str = ""  # the topic, or the service's name
-    typename: str = ""
-    latched: bool = False
-
-
-_ENTITY_KINDS = {"p": "publisher", "s": "subscription", "v": "service", "c": "client"}
-
-
-def parse_graph_key(key: str) -> GraphEntity | None:
-    parts = key.split("/")
-    # rl / D / g / zid / kind / node [/ topic / type [/ durability]]
-    if len(parts) < 6 or parts[0] != "rl" or parts[2] != "g":
-        return None
-    zid, kind, node = parts[3], parts[4], decode_name(parts[5])
-    if kind == "n":
-        return GraphEntity(zid, "node", node)
-    if kind in _ENTITY_KINDS and len(parts) >= 8:
-        return GraphEntity(
-            zid,
-            _ENTITY_KINDS[kind],
-            node,
-            decode_name(parts[6]),
-            decode_name(parts[7]),
-            latched=len(parts) > 8 and parts[8] == "latched",
-        )
-    return None
-
-
-def query_graph(
-    session: zenoh.Session, domain: int = 0, timeout_s: float = 1.0
-) -> list[GraphEntity]:
-    """Every node, publisher and subscription visible on the network."""
-    out: list[GraphEntity] = []
-    for reply in session.liveliness().get(f"rl/{domain}/g/**", timeout=timeout_s):
-        if reply.ok is not None:
-            ent = parse_graph_key(str(reply.ok.key_expr))
-            if ent is not None:
-                out.append(ent)
-    return out
-
-
-def query_parameters(
-    session: zenoh.Session,
-    node: str,
-    request: dict[str, Any],
-    domain: int = 0,
-    timeout_s: float = 3.0,
-) -> dict[str, Any]:
-    """Send a parameter request (``{"op": "get"|"set"|"list"|"dump", ...}``) to a node."""
-    fq = node if node.startswith("/") else "/" + node
-    answers: list[dict[str, Any]] = []
-    for reply in session.get(
-        f"rl/{domain}/p/{encode_name(fq)}", payload=json.dumps(request), timeout=timeout_s
-    ):
-        if reply.ok is not None:
-            answers.append(json.loads(reply.ok.payload.to_bytes()))
-    if not answers:
-        raise ParameterError(f"node '{fq}' not found (is it running?)")
-    return answers[0]
