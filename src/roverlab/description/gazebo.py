@@ -28,7 +28,7 @@ import xml.etree.ElementTree as ET
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import replace
 from types import MappingProxyType
-from typing import Final
+from typing import Final, TypedDict
 
 from roverlab.description.errors import URDFError
 from roverlab.description.gazebo_planar import parse_planar_move
@@ -156,16 +156,39 @@ def _camera(elem: ET.Element, where: str) -> CameraSpec:
 
 
 # ----------------------------------------------------------------- plugin specs
+class _DriveNames(TypedDict):
+    """The topics and frames both drive plugins read, with the same defaults."""
+
+    command_topic: str
+    odometry_topic: str
+    odometry_frame: str
+    robot_base_frame: str
+
+
+def _drive_names(v: ElementValues, ns: str) -> _DriveNames:
+    """Topics resolved in ``ns``, frames prefixed with it."""
+    return _DriveNames(
+        command_topic=resolve_topic(ns, v.text("commandTopic", "cmd_vel")),
+        odometry_topic=resolve_topic(ns, v.text("odometryTopic", "odom")),
+        odometry_frame=resolve_frame(ns, v.text("odometryFrame", "odom")),
+        robot_base_frame=resolve_frame(ns, v.text("robotBaseFrame", "base_footprint")),
+    )
+
+
+def _checked_wheels(v: ElementValues, spec: DiffDriveSpec) -> DiffDriveSpec:
+    """``spec``, once its wheel separation and diameter are known to be positive."""
+    if spec.wheel_separation_m <= 0 or spec.wheel_diameter_m <= 0:
+        raise v.fail("wheelSeparation", "wheelSeparation and wheelDiameter must be > 0")
+    return spec
+
+
 def _diff_drive(v: ElementValues, plugin: GazeboPlugin) -> DiffDriveSpec:
     ns = v.text("robotNamespace", "")
     source = v.text("odometrySource", "world")
     if source not in ("world", "encoder"):
         raise v.fail("odometrySource", f"'{source}' is not 'world' or 'encoder'")
     spec = DiffDriveSpec(
-        command_topic=resolve_topic(ns, v.text("commandTopic", "cmd_vel")),
-        odometry_topic=resolve_topic(ns, v.text("odometryTopic", "odom")),
-        odometry_frame=resolve_frame(ns, v.text("odometryFrame", "odom")),
-        robot_base_frame=resolve_frame(ns, v.text("robotBaseFrame", "base_footprint")),
+        **_drive_names(v, ns),
         publish_odom_tf=v.flag("publishOdomTF", True),
         publish_odom_topic=v.flag("publishOdomTopic", True),
         publish_wheel_tf=v.flag("publishWheelTF", False),
@@ -182,9 +205,7 @@ def _diff_drive(v: ElementValues, plugin: GazeboPlugin) -> DiffDriveSpec:
         legacy_mode=v.flag("legacyMode", True),
         robot_namespace=ns,
     )
-    if spec.wheel_separation_m <= 0 or spec.wheel_diameter_m <= 0:
-        raise v.fail("wheelSeparation", "wheelSeparation and wheelDiameter must be > 0")
-    return spec
+    return _checked_wheels(v, spec)
 
 
 def _skid_steer(v: ElementValues, plugin: GazeboPlugin) -> DiffDriveSpec:
@@ -193,10 +214,7 @@ def _skid_steer(v: ElementValues, plugin: GazeboPlugin) -> DiffDriveSpec:
     ``broadcastTF`` (default false), ``torque`` (not ``wheelTorque``) on each wheel."""
     ns = v.text("robotNamespace", "")
     spec = DiffDriveSpec(
-        command_topic=resolve_topic(ns, v.text("commandTopic", "cmd_vel")),
-        odometry_topic=resolve_topic(ns, v.text("odometryTopic", "odom")),
-        odometry_frame=resolve_frame(ns, v.text("odometryFrame", "odom")),
-        robot_base_frame=resolve_frame(ns, v.text("robotBaseFrame", "base_footprint")),
+        **_drive_names(v, ns),
         publish_odom_tf=v.flag("broadcastTF", False),
         odometry_source="world",
         wheel_separation_m=v.non_negative("wheelSeparation", 0.4),
@@ -212,9 +230,7 @@ def _skid_steer(v: ElementValues, plugin: GazeboPlugin) -> DiffDriveSpec:
         legacy_mode=False,
         robot_namespace=ns,
     )
-    if spec.wheel_separation_m <= 0 or spec.wheel_diameter_m <= 0:
-        raise v.fail("wheelSeparation", "wheelSeparation and wheelDiameter must be > 0")
-    return spec
+    return _checked_wheels(v, spec)
 
 
 def _laser(v: ElementValues, plugin: GazeboPlugin) -> LaserPluginSpec:

@@ -102,7 +102,6 @@ class Buffer(BufferCore):
         transform to become available; then the lookup's own error is raised, as tf2_ros."""
         return self._lookup_waiting(
             functools.partial(super().lookup_transform, target_frame, source_frame, time),
-            lambda: self._why_not(target_frame, source_frame, time) is None,
             timeout,
         )
 
@@ -117,9 +116,7 @@ class Buffer(BufferCore):
     ) -> tuple[Transform3, Time]:
         args = (target_frame, target_time, source_frame, source_time, fixed_frame)
         return self._lookup_waiting(
-            functools.partial(super().lookup_transform_full, *args),
-            lambda: self._why_not_full(*args) is None,
-            timeout,
+            functools.partial(super().lookup_transform_full, *args), timeout
         )
 
     def lookup_transform_msg(
@@ -156,10 +153,9 @@ class Buffer(BufferCore):
         time: Time,
         timeout: Duration | float = 0.0,
     ) -> bool:
+        ready = functools.partial(super().can_transform, target_frame, source_frame, time)
         with self._cond:
-            return self._wait(
-                lambda: self._why_not(target_frame, source_frame, time) is None, timeout
-            )
+            return self._wait(ready, timeout)
 
     def can_transform_full(
         self,
@@ -171,8 +167,9 @@ class Buffer(BufferCore):
         timeout: Duration | float = 0.0,
     ) -> bool:
         args = (target_frame, target_time, source_frame, source_time, fixed_frame)
+        ready = functools.partial(super().can_transform_full, *args)
         with self._cond:
-            return self._wait(lambda: self._why_not_full(*args) is None, timeout)
+            return self._wait(ready, timeout)
 
     def wait_for_transform(
         self,
@@ -187,8 +184,9 @@ class Buffer(BufferCore):
             TimeoutException: not available after ``timeout``; the lookup error that
                 remained is chained as its cause.
         """
+        ready = functools.partial(super().can_transform, target_frame, source_frame, time)
         with self._cond:
-            if self._wait(lambda: self._why_not(target_frame, source_frame, time) is None, timeout):
+            if self._wait(ready, timeout):
                 return
             try:
                 super().lookup_transform(target_frame, source_frame, time)
@@ -250,20 +248,17 @@ class Buffer(BufferCore):
 
     # ------------------------------------------------------------------ internals
     def _lookup_waiting(
-        self,
-        lookup: Callable[[], tuple[Transform3, Time]],
-        ready: Callable[[], bool],
-        timeout: Duration | float,
+        self, lookup: Callable[[], tuple[Transform3, Time]], timeout: Duration | float
     ) -> tuple[Transform3, Time]:
-        """``lookup()``; if it fails and ``timeout`` is positive, wait until ``ready()`` or
-        the timeout, then ``lookup()`` again (its error is the one raised)."""
+        """``lookup()``; if it fails and ``timeout`` is positive, wait until it would succeed
+        or the timeout, then ``lookup()`` again (its error is the one raised)."""
         with self._cond:
             try:
                 return lookup()
             except TransformException:
                 if _duration_ns(timeout) <= 0:
                     raise
-            self._wait(ready, timeout)
+            self._wait(lambda: self._succeeds(lookup), timeout)
             return lookup()
 
     def _wait(self, ready: Callable[[], bool], timeout: Duration | float) -> bool:

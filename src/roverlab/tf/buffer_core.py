@@ -16,7 +16,7 @@ the latest time at which every edge of the chain has data.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from typing import Final
 
 from roverlab.core.time import Duration, Time
@@ -233,7 +233,9 @@ class BufferCore:
 
     def can_transform(self, target_frame: str, source_frame: str, time: Time) -> bool:
         """True when :meth:`lookup_transform` with these arguments would succeed."""
-        return self._why_not(target_frame, source_frame, time) is None
+        return self._succeeds(
+            lambda: self._lookup_pose(target_frame, source_frame, time.nanoseconds)
+        )
 
     def can_transform_full(
         self,
@@ -244,9 +246,10 @@ class BufferCore:
         fixed_frame: str,
     ) -> bool:
         """True when :meth:`lookup_transform_full` with these arguments would succeed."""
-        return (
-            self._why_not_full(target_frame, target_time, source_frame, source_time, fixed_frame)
-            is None
+        return self._succeeds(
+            lambda: self._lookup_full_pose(
+                target_frame, target_time, source_frame, source_time, fixed_frame
+            )
         )
 
     def get_latest_common_time(self, target_frame: str, source_frame: str) -> Time:
@@ -379,28 +382,14 @@ class BufferCore:
             )
         raise LookupException(f'"{frame_id}" passed to {arg} does not exist.')
 
-    def _why_not(self, target_frame: str, source_frame: str, time: Time) -> str | None:
+    @staticmethod
+    def _succeeds(lookup: Callable[[], object]) -> bool:
+        """True when ``lookup()`` raises no :class:`TransformException`."""
         try:
-            self._lookup_pose(target_frame, source_frame, time.nanoseconds)
-        except TransformException as err:
-            return str(err)
-        return None
-
-    def _why_not_full(
-        self,
-        target_frame: str,
-        target_time: Time,
-        source_frame: str,
-        source_time: Time,
-        fixed_frame: str,
-    ) -> str | None:
-        try:
-            self._lookup_full_pose(
-                target_frame, target_time, source_frame, source_time, fixed_frame
-            )
-        except TransformException as err:
-            return str(err)
-        return None
+            lookup()
+        except TransformException:
+            return False
+        return True
 
     def _lookup_full_pose(
         self,

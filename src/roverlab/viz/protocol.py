@@ -137,20 +137,12 @@ def encode_points(
     colours = np.asarray(palette, dtype=np.uint8).reshape(-1, 4)
     n_buckets = len(colours)
     flags = POINTS_XYZ if dims == 3 else 0
+    per_point = b""  # RGBA bytes per point, after the points (with rgb only)
     if rgb is not None:
         flags |= POINTS_RGB
         alpha = np.full((len(pts), 1), colours[0, 3], dtype=np.uint8)
-        per_point = np.hstack((np.asarray(rgb, dtype=np.uint8).reshape(-1, 3), alpha))
-        counts = np.array([len(pts)] + [0] * (n_buckets - 1), dtype="<u4")
-        head = struct.pack("<BBHII", KIND_POINTS, flags, slot, len(pts), n_buckets)
-        return (
-            head
-            + counts.tobytes()
-            + colours.tobytes()
-            + np.ascontiguousarray(pts, dtype="<f4").tobytes()
-            + per_point.tobytes()
-        )
-    if buckets is None:
+        per_point = np.hstack((np.asarray(rgb, dtype=np.uint8).reshape(-1, 3), alpha)).tobytes()
+    if rgb is not None or buckets is None:
         counts = np.array([len(pts)] + [0] * (n_buckets - 1), dtype="<u4")
     else:
         idx = np.clip(np.asarray(buckets, dtype=np.int64).reshape(-1), 0, n_buckets - 1)
@@ -163,6 +155,7 @@ def encode_points(
         + counts.tobytes()
         + colours.tobytes()
         + np.ascontiguousarray(pts, dtype="<f4").tobytes()
+        + per_point
     )
 
 

@@ -84,6 +84,31 @@ def _adjust_resolution(plan: NDArray[np.float64], resolution: float) -> NDArray[
     return np.concatenate(out)
 
 
+def _first_known_stretch(plan: NDArray[np.float64], cm: Costmap2D) -> NDArray[np.int64] | None:
+    """The cells ``(ix, iy)`` of ``plan`` (at the costmap's resolution, see
+    :func:`_adjust_resolution`) from its first point on a known cell of ``cm`` up to the
+    point before the next one that is off the map or on unknown cost; None when no point
+    is on a known cell."""
+    res = cm.resolution
+    adjusted = _adjust_resolution(plan, res)
+    cells = np.floor((adjusted - [cm.origin_x, cm.origin_y]) / res).astype(np.int64)
+    inside = (
+        (adjusted[:, 0] >= cm.origin_x)
+        & (adjusted[:, 1] >= cm.origin_y)
+        & (cells[:, 0] < cm.size_x)
+        & (cells[:, 1] < cm.size_y)
+    )
+    ok = inside.copy()
+    ok[inside] = cm.costs[cells[inside, 1], cells[inside, 0]] != NO_INFORMATION
+    idx = np.nonzero(ok)[0]
+    if len(idx) == 0:
+        return None
+    first = idx[0]
+    stop = np.nonzero(~ok[first:])[0]
+    end = len(ok) if len(stop) == 0 else first + int(stop[0])
+    return cells[first:end]
+
+
 class DWAPlanner:
     """DWAPlannerROS.
 
@@ -176,53 +201,27 @@ class DWAPlanner:
     def _update_local_costs(self, pose: SE2, plan: NDArray[np.float64], cm: Costmap2D) -> None:
         p = self.params
         res = cm.resolution
-        adjusted = _adjust_resolution(plan, res)
-        cells = np.floor((adjusted - [cm.origin_x, cm.origin_y]) / res).astype(np.int64)
-        inside = (
-            (adjusted[:, 0] >= cm.origin_x)
-            & (adjusted[:, 1] >= cm.origin_y)
-            & (cells[:, 0] < cm.size_x)
-            & (cells[:, 1] < cm.size_y)
-        )
-        ok = inside.copy()
-        ok[inside] = cm.costs[cells[inside, 1], cells[inside, 0]] != NO_INFORMATION
-        idx = np.nonzero(ok)[0]
+        stretch = _first_known_stretch(plan, cm)
         shape = (cm.size_y, cm.size_x)
         path_grid = np.empty(shape)
         goal_grid = np.empty(shape)
         front_grid = np.empty(shape)
-        if len(idx) == 0:
+        if stretch is None:
             raise InvalidPathError(
                 "dwa_local_planner: none of the points of the global plan are in the local "
                 "costmap and free"
             )
-        first = idx[0]
-        stop = np.nonzero(~ok[first:])[0]
-        end = len(ok) if len(stop) == 0 else first + int(stop[0])
-        target_distance(cm.costs, np.ascontiguousarray(cells[first:end]), path_grid)
+        target_distance(cm.costs, np.ascontiguousarray(stretch), path_grid)
         # local goal: the last point of the plan's first stretch in the map
-        target_distance(cm.costs, np.ascontiguousarray(cells[end - 1 : end]), goal_grid)
+        target_distance(cm.costs, np.ascontiguousarray(stretch[-1:]), goal_grid)
         g = plan[-1]
         ang = math.atan2(g[1] - pose.y, g[0] - pose.x)
         front = plan.copy()
         front[-1, 0] += p.forward_point_distance * math.cos(ang)
         front[-1, 1] += p.forward_point_distance * math.sin(ang)
-        fadj = _adjust_resolution(front, res)
-        fcells = np.floor((fadj - [cm.origin_x, cm.origin_y]) / res).astype(np.int64)
-        fin = (
-            (fadj[:, 0] >= cm.origin_x)
-            & (fadj[:, 1] >= cm.origin_y)
-            & (fcells[:, 0] < cm.size_x)
-            & (fcells[:, 1] < cm.size_y)
-        )
-        fok = fin.copy()
-        fok[fin] = cm.costs[fcells[fin, 1], fcells[fin, 0]] != NO_INFORMATION
-        fidx = np.nonzero(fok)[0]
-        if len(fidx):
-            ff = fidx[0]
-            fstop = np.nonzero(~fok[ff:])[0]
-            fend = len(fok) if len(fstop) == 0 else ff + int(fstop[0])
-            target_distance(cm.costs, np.ascontiguousarray(fcells[fend - 1 : fend]), front_grid)
+        front_stretch = _first_known_stretch(front, cm)
+        if front_stretch is not None:
+            target_distance(cm.costs, np.ascontiguousarray(front_stretch[-1:]), front_grid)
         else:
             front_grid[:] = cm.size_x * cm.size_y + 1
         self._grids = (path_grid, goal_grid, front_grid)
