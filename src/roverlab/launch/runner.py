@@ -279,7 +279,12 @@ def build_launch(
         LaunchError: a malformed file, a missing file or package, a bad node argument.
     """
     spec = path if isinstance(path, LaunchSpec) else load_launch(path, args)
-    state = LaunchState(context=context, params=spec.params, warnings=list(spec.warnings))
+    state = LaunchState(
+        context=context,
+        params=spec.params,
+        param_sources=spec.param_sources,
+        warnings=list(spec.warnings),
+    )
     launch = Launch(context=context, spec=spec, state=state, scripts=dict(scripts or {}))
     for node_spec in spec.nodes:
         launch.start_node(node_spec)
