@@ -18,6 +18,7 @@ install: $(VENV)/.installed
 run: install
 	$(VENV)/bin/roverlab demo
 
+# examples/ is left out: the user's seed scripts, kept as given (pyproject's extend-exclude)
 lint: install
 	$(VENV)/bin/ruff check src tests benchmarks
 	$(VENV)/bin/ruff format --check src tests benchmarks

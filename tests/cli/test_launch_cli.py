@@ -143,3 +143,36 @@ def test_only_nodes_that_run_as_scripts_open_the_script_endpoint(
     assert asked == [(None, ())]
     err = capfd.readouterr().err
     assert "multiple files named [twice.py]" in err and "driver_node is not a Python" in err
+
+
+def test_each_script_node_type_is_looked_up_once(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``roverlab launch`` finds the scripts (to know whether it needs the script endpoint)
+    and the runner starts them from that: the package is not walked again per node."""
+    from roverlab.launch import process
+    from tests.helpers.nodes import run_main
+
+    pkg = tmp_path / "ws" / "my_pkg"
+    (pkg / "nodes").mkdir(parents=True)
+    (pkg / "package.xml").write_text("<package><name>my_pkg</name></package>")
+    (pkg / "nodes" / "driver_node").write_bytes(b"\x7fELF\x02\x01\x01")
+    monkeypatch.setenv("ROS_PACKAGE_PATH", str(tmp_path / "ws"))
+    path = _launch(
+        tmp_path,
+        '<node pkg="my_pkg" type="driver_node" name="a"/>'
+        '<node pkg="my_pkg" type="driver_node" name="a" ns="r2"/>'
+        '<node pkg="my_pkg" type="absent.py" name="c"/>',
+    )
+    looked_up: list[tuple[str, str]] = []
+    find_script = process.find_script
+
+    def counting(pkg: str, type_: str, package_path: tuple[str, ...] = ()) -> Path:
+        looked_up.append((pkg, type_))
+        return find_script(pkg, type_, package_path)
+
+    monkeypatch.setattr(process, "find_script", counting)
+    monkeypatch.setattr("roverlab.launch.runner.find_script", counting)
+    argv = ["launch", str(path), "--rate", "max", "--clock", "wall", "--duration", "0.05"]
+    assert run_main(argv) == 0
+    assert sorted(looked_up) == [("my_pkg", "absent.py"), ("my_pkg", "driver_node")]

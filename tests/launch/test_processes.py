@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 from roverlab.core import Context, configure_logging
-from roverlab.launch import LaunchError, build_launch, load_launch
+from roverlab.launch import LaunchError, NodeSpec, build_launch, load_launch
+from roverlab.launch.process import ChildNetwork, ScriptProcess
 from roverlab.maps import save_map
 
 TF = '<node pkg="tf" type="static_transform_publisher" name="{name}" args="0 0 0 0 0 0 a b 100"{extra}/>'  # noqa: E501
@@ -145,6 +146,49 @@ def test_output_log_keeps_info_off_the_screen_and_in_the_nodes_file(
     text = (tmp_path / "logs" / "quiet.log").read_text()
     assert "[INFO]" in text and "quiet says hello" in text and "quiet warns" in text
     assert not (tmp_path / "logs" / "loud.log").exists()
+
+
+def test_same_named_nodes_in_two_namespaces_log_to_files_of_their_own(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The log file is named after the node's resolved name (roslaunch's, with ``-`` for
+    the slashes): ``/robot1/tf`` and ``/robot2/tf`` do not share ``tf.log``."""
+    monkeypatch.setenv("ROVERLAB_LOG_DIR", str(tmp_path / "logs"))
+    path = _launch(tmp_path, "\n".join(
+        f'<group ns="{ns}">{TF.format(name="tf", extra="")}</group>' for ns in ("robot1", "robot2")
+    ))  # fmt: skip
+    ctx = Context()
+    try:
+        launch = build_launch(path, context=ctx)
+        for ns in ("robot1", "robot2"):
+            launch.running[f"/{ns}/tf"][1].get_logger().warning(f"{ns} says hello")
+    finally:
+        ctx.shutdown()
+    for ns, other in (("robot1", "robot2"), ("robot2", "robot1")):
+        text = (tmp_path / "logs" / f"{ns}-tf.log").read_text()
+        assert f"{ns} says hello" in text and other not in text
+    assert not (tmp_path / "logs" / "tf.log").exists()
+
+
+def test_same_named_script_processes_log_to_files_of_their_own(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A script process's stdout (``output="log"``) goes to the file of its resolved name;
+    ``launch-prefix="echo"`` makes the process print its own command line there."""
+    monkeypatch.setenv("ROVERLAB_LOG_DIR", str(tmp_path / "logs"))
+    script = tmp_path / "talker.py"
+    script.write_text("print('hi')\n")
+    procs = []
+    for ns in ("/robot1", "/robot2"):
+        spec = NodeSpec("my_pkg", "talker.py", "talker", namespace=ns, launch_prefix="echo")
+        procs.append(ScriptProcess(spec, script, clock="wall", params={}, network=ChildNetwork()))
+    for proc in procs:
+        assert proc.popen.wait(10) == 0
+        proc.stop()
+    logs = tmp_path / "logs"
+    assert sorted(p.name for p in logs.iterdir()) == ["robot1-talker.log", "robot2-talker.log"]
+    for ns in ("robot1", "robot2"):
+        assert (logs / f"{ns}-talker.log").read_text().split()[-1] == f"__ns:=/{ns}"
 
 
 def test_env_is_set_for_the_nodes_of_its_scope_only(

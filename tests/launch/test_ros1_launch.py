@@ -5,6 +5,7 @@ refused, the Gazebo world's and robot's warnings."""
 from __future__ import annotations
 
 from pathlib import Path
+from xml.sax.saxutils import quoteattr
 
 import pytest
 
@@ -69,11 +70,58 @@ def test_gazebo_launch_static_tfs_joystick_refused_and_world_warnings() -> None:
     joy = [w for w in started.warnings if "no joystick here" in w]
     assert len(joy) == 2 and "joy/joy_node" in joy[0] and "teleop_twist_joy" in joy[1]
     assert started.simulator is not None
+    xacro = PKGS / "book_robot_description" / "urdf" / "robot_with_laser.urdf.xacro"
+    assert started.robot_warnings  # named by the file robot_description's xacro read
+    assert all(w.startswith(f"{xacro}: ") for w in started.robot_warnings)
     assert (
         started.world_warnings
         == [w for w in started.world_warnings if w.startswith("2 models skipped: hydrant_0")]
         and len(started.world_warnings) == 1
     )
+
+
+ROBOT = """<robot name="box" xmlns:xacro="http://www.ros.org/wiki/xacro">
+  <xacro:property name="side" value="0.4"/>
+  <link name="base_link"><collision><geometry><box size="${side} ${side} 0.2"/></geometry>
+  </collision></link>
+  <gazebo reference="base_link"><mu1>0.2</mu1></gazebo>
+</robot>"""
+
+
+@pytest.mark.parametrize("how", ["xacro", "textfile", "value"])
+def test_the_spawned_robots_notes_name_the_file_its_parameter_read(
+    tmp_path: Path, how: str
+) -> None:
+    """A robot spawned from ``-param robot_description`` is named in its notes (and
+    warnings) by the file the parameter was read from, else by the launch's element:
+    never ``<string>``."""
+    robot = tmp_path / "box.urdf.xacro"
+    robot.write_text(ROBOT)
+    urdf = tmp_path / "box.urdf"
+    urdf.write_text(ROBOT.replace("${side}", "0.4"))
+    param = {
+        "xacro": f"command=\"$(find xacro)/xacro --inorder '{robot}'\"",
+        "textfile": f'textfile="{urdf}"',
+        "value": f"value={quoteattr(urdf.read_text())}",
+    }[how]
+    path = tmp_path / "box.launch"
+    path.write_text(
+        '<launch><include file="$(find gazebo_ros)/launch/empty_world.launch"/>'
+        f'<param name="robot_description" {param}/>'
+        '<node name="spawn" pkg="gazebo_ros" type="spawn_model" '
+        'args="-urdf -model box -param robot_description"/></launch>'
+    )
+    ctx = Context(clock="sim")
+    try:
+        started = build_launch(path, context=ctx)
+    finally:
+        ctx.shutdown()
+    (note,) = [n for n in started.notes if "mu1" in n]
+    source = {"xacro": str(robot), "textfile": str(urdf)}.get(
+        how, f'{path}: <param name="robot_description">'
+    )
+    assert note.startswith(f"{source}: <gazebo reference> settings not simulated"), note
+    assert "<string>" not in note
 
 
 def test_tf_static_transform_publisher_needs_its_period(tmp_path: Path) -> None:

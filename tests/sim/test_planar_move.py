@@ -176,6 +176,49 @@ def test_cmd_timeout_stops_the_body_and_a_new_command_restarts_it() -> None:
     assert sim.simulator.x == pytest.approx(0.2 + 0.4 * 0.8, abs=1e-9)
 
 
+def _pending_with_a_command_stream(plugin: str) -> tuple[int, float]:
+    """Commands at 100 Hz for 2 s: the executor's queued events after them, and x."""
+    ctx = Context()
+    sim = Simulation(context=ctx, world=_EMPTY, robot=_omni(plugin))
+    pub = ctx.create_node("driver").create_publisher(Twist, "/cmd_vel", 1)
+    for _ in range(200):
+        pub.publish(Twist(linear_x=0.4))
+        ctx.spin_for(0.01)
+    return ctx.executor.pending(), sim.simulator.x
+
+
+def test_a_command_stream_keeps_one_timeout_pending() -> None:
+    """Each command moves the deadline; it does not queue an expiry of its own (a 1 s
+    timeout at 100 Hz would hold 100 of them)."""
+    without, x0 = _pending_with_a_command_stream("")
+    with_timeout, x1 = _pending_with_a_command_stream("<cmdTimeout>1.0</cmdTimeout>")
+    assert with_timeout == without + 1
+    assert x1 == x0 == pytest.approx(0.8, abs=1e-9)  # never timed out
+
+
+def test_a_teleport_leaves_no_stale_command_odometry_or_timeout() -> None:
+    ctx = Context()
+    sim = Simulation(context=ctx, world=_EMPTY, robot=_omni("<cmdTimeout>0.5</cmdTimeout>"))
+    got = collect(ctx, {"/odom": "nav_msgs/msg/Odometry"})
+    pub = _drive(ctx, linear_x=0.4)
+    ctx.spin_for(0.32)
+    s = sim.simulator
+    s.teleport(3.0, -2.0, 1.0)
+    assert s.planar_move is not None
+    s.planar_move.reset()  # what the simulator's teleport does for its drive plugin
+    ctx.spin_for(0.3)
+    assert (s.x, s.y, s.yaw) == (3.0, -2.0, pytest.approx(1.0))  # at rest
+    after = [m for m in got["/odom"] if time_to_ns(m.header.stamp) > 320_000_000]
+    assert after and all(
+        (m.twist.twist.linear.x, m.twist.twist.linear.y, m.twist.twist.angular.z) == (0, 0, 0)
+        for m in after
+    )  # not the jump over the message's period
+    # a command after the teleport gets a timeout of its own, 0.5 s after it
+    pub.publish(Twist(linear_x=0.4))
+    ctx.spin_for(1.0)
+    assert (s.x, s.y) == pytest.approx((3.0 + 0.2 * math.cos(1.0), -2.0 + 0.2 * math.sin(1.0)))
+
+
 def test_without_cmd_timeout_the_last_command_holds() -> None:
     ctx = Context()
     sim = Simulation(context=ctx, world=_EMPTY, robot=_omni())

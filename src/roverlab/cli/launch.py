@@ -23,8 +23,8 @@ from roverlab.cli.common import (
 from roverlab.cli.sim import parse_rate
 from roverlab.core import Context, configure_logging
 from roverlab.description import find_package
-from roverlab.launch import REGISTRY, LaunchError, LaunchSpec, build_launch, load_launch
-from roverlab.launch.process import is_script_node, launch_endpoint
+from roverlab.launch import LaunchError, LaunchSpec, build_launch, find_launch_scripts, load_launch
+from roverlab.launch.process import launch_endpoint
 
 CLOCKS = ("auto", "sim", "external", "wall")
 _SIMULATOR_NODES = {("gazebo_ros", "gzserver"), ("gazebo_ros", "spawn_model")}
@@ -153,18 +153,18 @@ def launch(
     mode, note = choose_clock(spec, clock, pace)
     if note:
         typer.echo(f"note: {note}", err=True)
-    # script nodes run in processes of their own, clients of this one (a private run too)
-    scripts = [
-        n for n in spec.nodes if (n.pkg, n.type) not in REGISTRY and is_script_node(n.pkg, n.type)
-    ]
+    # script nodes run in processes of their own, clients of this one (a private run too);
+    # each looked up once, here, and started from that by build_launch
+    scripts = find_launch_scripts(spec)
+    runs_scripts = any(isinstance(found, Path) for found in scripts.values())
     context = Context(clock=mode, rate=1.0 if math.isinf(pace) else pace)
     guard = StartGuard(context)
-    with _script_endpoint(bool(scripts)) as also_listen:
+    with _script_endpoint(runs_scripts) as also_listen:
         with guard:
             if record is not None:
                 guard.record(record)
             expose_if_asked(ctx, context, expose, pace, also_listen=also_listen)
-            started = build_launch(spec, context=context, seed=seed)
+            started = build_launch(spec, context=context, seed=seed, scripts=scripts)
         with guard:
             report_warnings(f"launch {path.name}", started.warnings, strict)
             report_warnings("Gazebo world", started.world_warnings, strict)

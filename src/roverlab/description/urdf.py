@@ -455,6 +455,7 @@ def load_robot(
     args: Mapping[str, str] | None = None,
     package_path: Iterable[str | os.PathLike[str]] = (),
     xacro_ns: bool = False,
+    source: str | None = None,
 ) -> RobotModel:
     """Load a robot from a ``.urdf`` / ``.xacro`` / ``.urdf.xacro`` file or an XML string.
 
@@ -463,11 +464,15 @@ def load_robot(
         args: xacro arguments, ``{"laser_visual": "true"}`` for ``laser_visual:=true``.
         package_path: extra folders where ``$(find pkg)`` looks (after the environment
             and the bundled packages).
+        source: where a document given as a string came from (the file a launch's
+            ``<param command="xacro FILE">`` read), named in the model's messages
+            instead of ``<string>``.
 
     Raises:
         XacroError: the xacro expansion failed.
         URDFError: the robot is not valid.
     """
-    source = "<string>" if _is_xml(path_or_xml) else str(path_or_xml)
+    if not _is_xml(path_or_xml):
+        source = str(path_or_xml)
     xml_text = robot_description(path_or_xml, args, package_path=package_path, xacro_ns=xacro_ns)
-    return parse_urdf(xml_text, source=source)
+    return parse_urdf(xml_text, source=source or "<string>")

@@ -5,7 +5,7 @@ the nodes through :data:`REGISTRY` (ROS ``(pkg, type)`` -> roverlab node).
 """
 
 from roverlab.launch.registry import REGISTRY, LaunchState, register
-from roverlab.launch.runner import Launch, build_launch
+from roverlab.launch.runner import Launch, build_launch, find_launch_scripts
 from roverlab.launch.xml import LaunchError, LaunchSpec, NodeSpec, load_launch
 
 __all__ = [
@@ -16,6 +16,7 @@ __all__ = [
     "LaunchState",
     "NodeSpec",
     "build_launch",
+    "find_launch_scripts",
     "load_launch",
     "register",
 ]

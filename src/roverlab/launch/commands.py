@@ -12,7 +12,7 @@ from roverlab.description import robot_description
 from roverlab.description.errors import DescriptionError
 from roverlab.launch.errors import LaunchError
 
-__all__ = ["command_value", "xacro_argv"]
+__all__ = ["command_value", "xacro_argv", "xacro_input"]
 
 
 def command_value(command: str, where: str, package_path: tuple[str, ...] = ()) -> str:
@@ -43,10 +43,29 @@ def command_value(command: str, where: str, package_path: tuple[str, ...] = ()) 
     return done.stdout
 
 
+def xacro_input(command: str) -> str | None:
+    """The file a ``command=`` running xacro reads (as its messages name it), else
+    ``None`` (another command, or one :func:`command_value` refuses)."""
+    try:
+        xacro = xacro_argv(shlex.split(command))
+        return None if xacro is None else _xacro_options(xacro, "")[0]
+    except (ValueError, LaunchError):
+        return None
+
+
 def _xacro(argv: list[str], where: str, package_path: tuple[str, ...]) -> str:
+    path, mappings, xacro_ns = _xacro_options(argv, where)
+    try:
+        return robot_description(Path(path), mappings, package_path=package_path, xacro_ns=xacro_ns)
+    except DescriptionError as err:
+        raise LaunchError(f"{where}: {err}") from err
+
+
+def _xacro_options(argv: list[str], where: str) -> tuple[str, dict[str, str], bool]:
     """ROS 1's xacro command line: ``--inorder`` / ``-i`` (the default since melodic,
     accepted and ignored), ``--xacro-ns``, ``-o FILE`` (the output is the parameter
-    anyway), ``name:=value`` mappings and one input file."""
+    anyway), ``name:=value`` mappings and one input file: the file, the mappings and
+    ``--xacro-ns``."""
     files: list[str] = []
     mappings: dict[str, str] = {}
     xacro_ns = False
@@ -69,12 +88,7 @@ def _xacro(argv: list[str], where: str, package_path: tuple[str, ...]) -> str:
             files.append(a)
     if len(files) != 1:
         raise LaunchError(f"{where}: xacro command needs one input file")
-    try:
-        return robot_description(
-            Path(files[0]), mappings, package_path=package_path, xacro_ns=xacro_ns
-        )
-    except DescriptionError as err:
-        raise LaunchError(f"{where}: {err}") from err
+    return files[0], mappings, xacro_ns
 
 
 def xacro_argv(argv: list[str]) -> list[str] | None:

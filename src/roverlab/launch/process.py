@@ -25,6 +25,7 @@ from typing import IO, Any
 
 import yaml
 
+from roverlab.core.logfiles import node_log_file
 from roverlab.core.transport.zenoh import ZenohOptions, daemon_endpoint
 from roverlab.description import find_package
 from roverlab.description.errors import DescriptionError
@@ -40,7 +41,6 @@ __all__ = [
     "find_script",
     "find_scripts",
     "is_python_script",
-    "is_script_node",
     "launch_endpoint",
     "ros_home",
 ]
@@ -117,15 +117,6 @@ def find_script(pkg: str, type_: str, package_path: tuple[str, ...] = ()) -> Pat
             f"{found[0]} is not a Python script (roverlab runs rospy scripts, not compiled nodes)"
         )
     return found[0]
-
-
-def is_script_node(pkg: str, type_: str, package_path: tuple[str, ...] = ()) -> bool:
-    """Whether ``<node pkg type>`` runs as a script process (:func:`find_script` finds one)."""
-    try:
-        find_script(pkg, type_, package_path)
-    except ScriptLookupError:
-        return False
-    return True
 
 
 def is_python_script(path: Path) -> bool:
@@ -233,12 +224,13 @@ class ScriptProcess:
         argv += [f"__name:={spec.name}", f"__ns:={spec.namespace}"]
         self.argv = argv
         self._log: IO[bytes] | None = None
+        self.log_file: Path | None = None  # its stdout's file (output="log")
         stdout: IO[bytes] | None = None
         if spec.output == "log":  # roslaunch: stdout to the node's log file, stderr on screen
-            log_dir = Path(os.environ.get("ROVERLAB_LOG_DIR", Path.home() / ".roverlab" / "log"))
-            log_file = log_dir / f"{spec.name}.log"  # as the launch's own nodes' logs
+            log_file = node_log_file(spec.fq_name)  # as the launch's own nodes' logs
+            self.log_file = log_file
             try:
-                log_dir.mkdir(parents=True, exist_ok=True)
+                log_file.parent.mkdir(parents=True, exist_ok=True)
                 self._log = stdout = log_file.open("ab")
             except OSError as err:
                 raise LaunchError(

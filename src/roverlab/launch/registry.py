@@ -241,7 +241,9 @@ def _spawn(state: LaunchState, spec: NodeSpec) -> None:
         if full not in state.params:
             raise LaunchError(f"{spec.source}: spawn_model: parameter {full} is not set")
         state.spawn_urdf = str(state.params[full])
-        robot = load_robot(state.spawn_urdf)
+        # its messages name the file the parameter was read from, not <string>
+        where = state.param_sources.get(full, f"{spec.source}: parameter {full}")
+        robot = load_robot(state.spawn_urdf, source=where)
     elif "-file" in opts:
         robot = load_robot(Path(opts["-file"]))
         state.spawn_urdf = robot.urdf

@@ -14,6 +14,7 @@ from pathlib import Path
 from roverlab.core import Context, Node, QoSProfile
 from roverlab.core.executor import ClockMode
 from roverlab.core.log import log_to_file
+from roverlab.core.logfiles import node_log_file
 from roverlab.core.transport.zenoh import ZenohTransport
 from roverlab.description.check import robot_notes, robot_warnings
 from roverlab.launch.process import (
@@ -30,7 +31,10 @@ from roverlab.sim.node import SimulatorNode, SpawnPose
 from roverlab.sim.robot import sim_config_from_model
 from roverlab.world import world_warnings
 
-__all__ = ["Launch", "build_launch"]
+__all__ = ["Launch", "ScriptLookups", "build_launch", "find_launch_scripts"]
+
+#: ``(pkg, type)`` -> the script that ``<node pkg type>`` runs, or why none runs
+ScriptLookups = dict[tuple[str, str], Path | ScriptLookupError]
 
 
 @contextlib.contextmanager
@@ -47,6 +51,26 @@ def _environment(env: Mapping[str, str]) -> Iterator[None]:
                 os.environ.pop(k, None)
             else:
                 os.environ[k] = v
+
+
+def find_launch_scripts(spec: LaunchSpec) -> ScriptLookups:
+    """Each node type of ``spec`` that roverlab does not implement, looked up once as a
+    script of its package (:func:`find_script`): ``roverlab launch`` decides from it
+    whether the launch needs its script endpoint, and :func:`build_launch` starts the
+    scripts (or warns) from it without walking the packages again."""
+    found: ScriptLookups = {}
+    for node_spec in spec.nodes:
+        key = (node_spec.pkg, node_spec.type)
+        if key not in REGISTRY and key not in found:
+            found[key] = _lookup_script(*key)
+    return found
+
+
+def _lookup_script(pkg: str, type_: str) -> Path | ScriptLookupError:
+    try:
+        return find_script(pkg, type_)
+    except ScriptLookupError as err:
+        return err
 
 
 @dataclass
@@ -67,6 +91,8 @@ class Launch:
     notes: list[str] = field(default_factory=list)
     # the user's own scripts, each in a process of its own (roverlab run), by node name
     processes: dict[str, tuple[NodeSpec, ScriptProcess]] = field(default_factory=dict)
+    # the scripts of the node types roverlab lacks, each looked up once (a respawn too)
+    scripts: ScriptLookups = field(default_factory=dict)
     _group: ScriptProcesses | None = None
     _watch: threading.Thread | None = None
 
@@ -111,8 +137,8 @@ class Launch:
             )
             node.discard_parameter_overrides(unused)
         if node_spec.output == "log":
-            log_dir = Path(os.environ.get("ROVERLAB_LOG_DIR", Path.home() / ".roverlab" / "log"))
-            log_to_file(node.get_fully_qualified_name(), log_dir / f"{node_spec.name}.log")
+            name = node.get_fully_qualified_name()
+            log_to_file(name, node_log_file(name))
         self.nodes.append(node)
         self.running[node_spec.fq_name] = (node_spec, node)
         return node
@@ -128,11 +154,13 @@ class Launch:
         process of its own (as ``roverlab run``), else skipped with a warning."""
         assert self.state is not None
         what = f"{node_spec.source}: node {node_spec.pkg}/{node_spec.type}"
-        try:
-            script = find_script(node_spec.pkg, node_spec.type)
-        except ScriptLookupError as err:
-            joint = " is not part of roverlab, and" if err.missing else ":"
-            self.state.warnings.append(f"{what}{joint} {err}; skipped")
+        key = (node_spec.pkg, node_spec.type)
+        if key not in self.scripts:
+            self.scripts[key] = _lookup_script(*key)
+        script = self.scripts[key]
+        if isinstance(script, ScriptLookupError):
+            joint = " is not part of roverlab, and" if script.missing else ":"
+            self.state.warnings.append(f"{what}{joint} {script}; skipped")
             return
         if not os.access(script, os.X_OK):  # roslaunch: "found but it is not executable"
             self.notes.append(
@@ -237,9 +265,11 @@ def build_launch(
     *,
     context: Context,
     seed: int = 0,
+    scripts: ScriptLookups | None = None,
 ) -> Launch:
     """Read ``path`` (or take an already read :class:`LaunchSpec`, ``args`` unused) and
-    create its nodes in ``context``.
+    create its nodes in ``context``. ``scripts``: :func:`find_launch_scripts` of the spec,
+    when the caller has it already (else each script is looked up as its node starts).
 
     Nodes roverlab has no implementation of are skipped with a warning (ROS would fail to
     start them; skipping lets the rest of a launch file run). Parameters a node does not
@@ -249,8 +279,13 @@ def build_launch(
         LaunchError: a malformed file, a missing file or package, a bad node argument.
     """
     spec = path if isinstance(path, LaunchSpec) else load_launch(path, args)
-    state = LaunchState(context=context, params=spec.params, warnings=list(spec.warnings))
-    launch = Launch(context=context, spec=spec, state=state)
+    state = LaunchState(
+        context=context,
+        params=spec.params,
+        param_sources=spec.param_sources,
+        warnings=list(spec.warnings),
+    )
+    launch = Launch(context=context, spec=spec, state=state, scripts=dict(scripts or {}))
     for node_spec in spec.nodes:
         launch.start_node(node_spec)
         if context.is_shutdown():  # a required node failed to start

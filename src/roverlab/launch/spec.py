@@ -41,5 +41,8 @@ class LaunchSpec:
 
     nodes: list[NodeSpec] = field(default_factory=list)
     params: dict[str, Any] = field(default_factory=dict)  # global (absolute) names
+    # global name -> where its value came from, for messages about it: the file a
+    # <param command="xacro FILE"> or textfile= read, else the launch file's element
+    param_sources: dict[str, str] = field(default_factory=dict)
     files: list[Path] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)  # what roslaunch would warn about

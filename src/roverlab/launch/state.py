@@ -21,6 +21,7 @@ class LaunchState:
 
     context: Context
     params: dict[str, Any]
+    param_sources: dict[str, str] = field(default_factory=dict)  # LaunchSpec's
     world: Any = None
     world_source: str = ""
     spawns: list[tuple[Any, tuple[float, float, float], str]] = field(default_factory=list)

@@ -28,7 +28,7 @@ import yaml
 
 from roverlab.description import find_package
 from roverlab.description.errors import DescriptionError
-from roverlab.launch.commands import command_value, xacro_argv
+from roverlab.launch.commands import command_value, xacro_argv, xacro_input
 from roverlab.launch.errors import LaunchError
 from roverlab.launch.spec import LaunchSpec, NodeSpec
 
@@ -285,18 +285,23 @@ class _Reader:
         elif name not in scope.args and "default" in elem.attrib:
             scope.args[name] = self.attr(elem, "default", scope)
 
-    def put(self, scope: _Scope, name: str, value: Any, node: NodeSpec | None) -> None:
+    def put(self, scope: _Scope, name: str, value: Any, node: NodeSpec | None, source: str) -> None:
         """Set a parameter as roslaunch does: ``~name`` is private (to the ``node``, or to
         every node declared after it in this scope), ``/name`` global, else in the scope's
-        namespace (a node's private one inside ``<node>``)."""
+        namespace (a node's private one inside ``<node>``). ``source``: where the value
+        came from (:attr:`LaunchSpec.param_sources` of a global one)."""
         if name.startswith("/"):
-            self.spec.params[name.rstrip("/")] = value
+            full = name.rstrip("/")
         elif node is not None:
             node.params[name.lstrip("~").strip("/")] = value
+            return
         elif name.startswith("~"):
             scope.private[name[1:].strip("/")] = value
+            return
         else:
-            self.spec.params[_join(scope.ns, name.rstrip("/"))] = value
+            full = _join(scope.ns, name.rstrip("/"))
+        self.spec.params[full] = value
+        self.spec.param_sources[full] = source
 
     def on_param(self, elem: ET.Element, scope: _Scope, node: NodeSpec | None) -> None:
         name = self.attr(elem, "name", scope).strip()
@@ -308,6 +313,7 @@ class _Reader:
             )
         where = _where(scope, elem)
         text = self.attr(elem, sources[0], scope)
+        source = where  # the file it read, when there is one
         value: Any
         if sources[0] == "value":
             try:
@@ -316,14 +322,16 @@ class _Reader:
                 raise LaunchError(f"{where}: {err}") from err
         elif sources[0] == "command":
             value = command_value(text, where, self.package_path)
+            source = xacro_input(text) or where
         elif sources[0] == "textfile":
             value = self._read_text(Path(text), scope, elem)
+            source = text
         else:
             try:
                 value = Path(text).read_bytes()
             except OSError as err:
                 raise LaunchError(f"{where}: cannot read {text}: {err.strerror}") from err
-        self.put(scope, name, value, node)
+        self.put(scope, name, value, node, source)
 
     def on_rosparam(self, elem: ET.Element, scope: _Scope, node: NodeSpec | None) -> None:
         where = _where(scope, elem)
@@ -361,12 +369,12 @@ class _Reader:
         if not isinstance(data, dict):
             if not param:
                 raise LaunchError(f"{where}: a rosparam value that is not a mapping needs param=")
-            self.put(scope, param, data, node)
+            self.put(scope, param, data, node, where)
             return
         if not param and node is None and scope.ns == "/" and not data:
             return
         for key, value in _flatten(data).items():
-            self.put(scope, _rel(param, key), value, node)
+            self.put(scope, _rel(param, key), value, node, where)
 
     def on_node(self, elem: ET.Element, scope: _Scope, passed: set[str]) -> None:
         pkg = self.attr(elem, "pkg", scope)

@@ -9,12 +9,15 @@ is the plugin's topics:
 * ``cmd_vel`` in: a NaN or infinite component is a warning and the message is ignored;
   speeds beyond :class:`~roverlab.sim.config.PlanarMoveConfig`'s guards are clamped;
 * ``cmdTimeout`` (>= 0): once no command came for that long the body stops (the plugin
-  zeroes its command in the first update after the deadline);
+  zeroes its command in the first update after the deadline); one expiry event is
+  pending at a time, re-armed when a later command moved the deadline;
 * odometry at ``odometryRate``: the model's true pose, and the velocity as the plugin
   computes it: the pose's change since the previous message, turned into the base frame
   at the current heading (so it lags a change of command by up to one period);
 * the ``odom -> robotBaseFrame`` transform with the same pose and stamp, built only
-  while someone reads /tf.
+  while someone reads /tf;
+* :meth:`PlanarMovePlugin.reset` after a teleport: the body is at rest, no timeout is
+  pending, and the next odometry velocity is measured from the new pose (not the jump).
 """
 
 from __future__ import annotations
@@ -75,7 +78,8 @@ class PlanarMovePlugin:
         self._executor = node.context.executor
         timeout = config.cmd_timeout_s
         self._timeout_ns = round(timeout * 1e9) if timeout >= 0 else -1
-        self._deadline_ns: int | None = None
+        self._deadline_ns: int | None = None  # when the last command times out
+        self._expiry_armed = False  # one pending expiry event, whatever the command rate
         # the pose and time of the previous odometry message (at first: the spawn)
         self._last = (float(state[S_X]), float(state[S_Y]), float(state[S_TH]))
         self._last_ns = self._executor.now_ns
@@ -102,16 +106,33 @@ class PlanarMovePlugin:
         st[S_CW] = max(-c.max_turn_rate_rad_s, min(c.max_turn_rate_rad_s, wz))
         if self._timeout_ns >= 0:
             self._deadline_ns = self._executor.now_ns + self._timeout_ns
-            self._executor.call_at(self._deadline_ns, self._expire)
+            if not self._expiry_armed:
+                self._expiry_armed = True
+                self._executor.call_at(self._deadline_ns, self._expire)
 
     def _expire(self) -> None:
         deadline = self._deadline_ns
-        if deadline is None or self._executor.now_ns < deadline:
-            return  # a later command moved the deadline
+        if deadline is None:  # stopped already (a teleport)
+            self._expiry_armed = False
+            return
+        if self._executor.now_ns < deadline:  # a later command moved the deadline
+            self._executor.call_at(deadline, self._expire)
+            return
+        self._expiry_armed = False
         self._deadline_ns = None
         self._advance()  # the steps up to the deadline still move
         st = self._state
         st[S_CVX] = st[S_CVY] = st[S_CW] = 0.0
+
+    def reset(self) -> None:
+        """The body was put somewhere else, at rest (a teleport): the next odometry
+        message measures its velocity from here, and no timeout is pending."""
+        self._advance()
+        st = self._state
+        self._last = (float(st[S_X]), float(st[S_Y]), float(st[S_TH]))
+        self._last_ns = self._executor.now_ns
+        st[S_CVX] = st[S_CVY] = st[S_CW] = 0.0
+        self._deadline_ns = None
 
     def publish_odometry(self) -> None:
         """The odometry message (and the transform, when someone reads /tf)."""

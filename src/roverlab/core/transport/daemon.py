@@ -17,10 +17,10 @@ import sys
 import threading
 import time
 from dataclasses import replace
-from pathlib import Path
 
 from roverlab.core.context import Context
 from roverlab.core.errors import TransportError
+from roverlab.core.logfiles import log_dir as roverlab_log_dir
 from roverlab.core.transport.zenoh import (
     ZenohOptions,
     ZenohTransport,
@@ -54,7 +54,7 @@ def ensure_daemon(endpoint: str | None = None, timeout_s: float = 10.0) -> str:
     if endpoint_reachable(ep):
         return ep
     _loopback_only(ep)
-    log_dir = Path(os.environ.get("ROVERLAB_LOG_DIR", Path.home() / ".roverlab" / "log"))
+    log_dir = roverlab_log_dir()
     log_dir.mkdir(parents=True, exist_ok=True)
     with open(log_dir / "daemon.log", "ab") as log:
         subprocess.Popen(
