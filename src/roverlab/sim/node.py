@@ -294,6 +294,8 @@ class SimulatorNode(Node):
         st[S_X], st[S_Y], st[S_TH] = x, y, float(wrap_angle(yaw))
         for i in (S_VL, S_VR, S_TL, S_TR, S_V, S_W, S_DV, S_VY, S_LAT, S_CVX, S_CVY, S_CW):
             st[i] = 0.0
+        if self.planar_move is not None:  # its command, timeout and odometry start over
+            self.planar_move.reset()
 
     # ----------------------------------------------------------------- commands
     def _on_cmd(self, msg: Any) -> None:
