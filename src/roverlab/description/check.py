@@ -16,6 +16,7 @@ then the sensors and plugins, each marked supported or not by roverlab.
 from __future__ import annotations
 
 import math
+from typing import Final
 
 from roverlab.description.errors import DescriptionError
 from roverlab.description.gazebo import REFERENCE_KEYS
@@ -99,6 +100,29 @@ def robot_notes(model: RobotModel, *, detail: bool = False) -> list[str]:
         out.append(
             f"{src}: <gazebo> model settings not simulated: " + ", ".join(model.gazebo.model_params)
         )
+    out += _camera_notes(model)
+    return out
+
+
+# names tutorials give camera plugins that GazeboRosCameraUtils reads under other names
+_CAMERA_MISNAMED: Final = ("baseline", *(f"distortion_{k}" for k in ("k1", "k2", "k3", "t1", "t2")))
+
+
+def _camera_notes(model: RobotModel) -> list[str]:
+    """Camera plugin elements that Gazebo's plugin does not read either (so the published
+    CameraInfo ignores them there too): ``<baseline>`` and ``distortion_k1``..."""
+    out: list[str] = []
+    for plugin in model.gazebo.plugins:
+        if not isinstance(plugin.spec, CameraPluginSpec | KinectPluginSpec):
+            continue
+        unread = [k for k in _CAMERA_MISNAMED if k in plugin.params]
+        if unread:
+            out.append(
+                f"{model.source}: <plugin {plugin.filename}> on sensor '{plugin.reference}': "
+                f"{', '.join(unread)} not read by the plugin (Gazebo ignores them too; "
+                "CameraInfo's P[3] comes from hackBaseline, its D from distortionK1, "
+                "distortionK2, distortionT1, distortionT2, distortionK3)"
+            )
     return out
 
 

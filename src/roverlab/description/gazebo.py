@@ -242,16 +242,14 @@ def _laser(v: ElementValues, plugin: GazeboPlugin) -> LaserPluginSpec:
     )
 
 
-def _distortion(v: ElementValues, name: str) -> float:
-    """``distortionK1`` (what the camera utils read) or ``distortion_k1`` (seen in tutorials)."""
-    camel = "distortion" + name.upper()
-    snake = "distortion_" + name.lower()
-    return v.number(camel, v.number(snake, 0.0))
+_DISTORTION: Final = ("k1", "k2", "k3", "t1", "t2")
 
 
 def _distortions(v: ElementValues) -> dict[str, float]:
-    """The five ``distortion_*`` fields of a camera plugin spec."""
-    return {f"distortion_{k}": _distortion(v, k) for k in ("k1", "k2", "k3", "t1", "t2")}
+    """The five ``distortion_*`` fields of a camera plugin spec, from ``distortionK1``..
+    ``distortionT2`` (GazeboRosCameraUtils reads only these names: a ``distortion_k1``
+    seen in tutorials is ignored, and ``urdf check`` notes it)."""
+    return {f"distortion_{k}": v.number("distortion" + k.upper(), 0.0) for k in _DISTORTION}
 
 
 def _camera_plugin(v: ElementValues, plugin: GazeboPlugin) -> CameraPluginSpec:
@@ -284,7 +282,8 @@ def _kinect(v: ElementValues, plugin: GazeboPlugin) -> KinectPluginSpec:
             cns, v.text("depthImageCameraInfoTopicName", "depth/camera_info")
         ),
         frame_id=resolve_frame(ns, v.text("frameName", "/world")),
-        baseline=v.number("baseline", v.number("hackBaseline", 0.0)),
+        baseline=v.number("baseline", 0.0),
+        hack_baseline=v.number("hackBaseline", 0.0),
         point_cloud_cutoff_m=v.non_negative("pointCloudCutoff", 0.4),
         point_cloud_cutoff_max_m=v.non_negative("pointCloudCutoffMax", 5.0),
         update_rate_hz=v.non_negative("updateRate", 0.0),

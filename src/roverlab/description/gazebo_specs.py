@@ -274,7 +274,12 @@ class LaserPluginSpec:
 
 @dataclass(frozen=True, slots=True)
 class CameraPluginSpec:
-    """``libgazebo_ros_camera.so`` (GazeboRosCameraUtils' defaults)."""
+    """``libgazebo_ros_camera.so`` (GazeboRosCameraUtils' defaults).
+
+    ``hack_baseline`` (m) and the ``distortion_*`` coefficients go into the published
+    CameraInfo only (``p[3] = -fx * hack_baseline``, ``d = [k1, k2, t1, t2, k3]``), as
+    GazeboRosCameraUtils puts them; the image is not distorted by them.
+    """
 
     camera_name: str = ""
     image_topic: str = "/image_raw"
@@ -292,7 +297,13 @@ class CameraPluginSpec:
 
 @dataclass(frozen=True, slots=True)
 class KinectPluginSpec:
-    """``libgazebo_ros_openni_kinect.so``: RGB, depth image, point cloud, camera infos."""
+    """``libgazebo_ros_openni_kinect.so``: RGB, depth image, point cloud, camera infos.
+
+    Its camera infos are GazeboRosCameraUtils', as the camera plugin's: ``hack_baseline``
+    (``hackBaseline``) and the ``distortion_*`` coefficients. ``baseline`` is the
+    ``<baseline>`` element tutorials put in the plugin: the plugin reads nothing by that
+    name (``urdf check`` notes it).
+    """
 
     camera_name: str = ""
     image_topic: str = "/ir/image_raw"
@@ -302,6 +313,7 @@ class KinectPluginSpec:
     depth_image_camera_info_topic: str = "/depth/camera_info"
     frame_id: str = "world"
     baseline: float = 0.0
+    hack_baseline: float = 0.0
     point_cloud_cutoff_m: float = 0.4
     point_cloud_cutoff_max_m: float = 5.0
     update_rate_hz: float = 0.0

@@ -475,17 +475,23 @@ class SimulatorNode(Node):
 
         self.create_timer(1.0 / rate, tick)
 
-    def _camera_info(self, ns: int, frame: str, model: CameraModel) -> Any:
+    def _camera_info(
+        self, ns: int, frame: str, model: CameraModel, sensor: CameraSensor | DepthSensor
+    ) -> Any:
+        # as GazeboRosCameraUtils: d from the plugin's distortion coefficients (reported,
+        # not applied to the image), p[3] = -fx * hackBaseline
         p = model.params
         k = camera_intrinsics(p.width, p.height, p.horizontal_fov).k
         proj = np.zeros((3, 4))
         proj[:, :3] = k
+        if sensor.hack_baseline_m:
+            proj[0, 3] = -k[0, 0] * sensor.hack_baseline_m
         return mc.CameraInfo(
             header=_header(ns, frame),
             height=p.height,
             width=p.width,
             distortion_model="plumb_bob",
-            d=np.zeros(5),
+            d=np.array(sensor.distortion, dtype=np.float64),
             k=k.reshape(-1),
             r=np.eye(3).reshape(-1),
             p=proj.reshape(-1),
@@ -509,7 +515,7 @@ class SimulatorNode(Node):
             x, y, z, yaw, pitch = self.sensor_pose(sensor.mount)
             rgb = model.capture_rgb(self.scene, x, y, z, yaw, pitch)
             image_pub.publish(_image(ns, sensor.frame_id, rgb, "rgb8"))
-            info_pub.publish(self._camera_info(ns, sensor.frame_id, model))
+            info_pub.publish(self._camera_info(ns, sensor.frame_id, model, sensor))
 
         self.create_timer(1.0 / sensor.update_rate_hz, tick)
 
@@ -532,7 +538,7 @@ class SimulatorNode(Node):
             rgb, depth = model.capture(self.scene, x, y, z, yaw, pitch)
             image_pub.publish(_image(ns, sensor.frame_id, rgb, "rgb8"))
             depth_pub.publish(_image(ns, sensor.frame_id, depth, "32FC1"))
-            info = self._camera_info(ns, sensor.frame_id, model)
+            info = self._camera_info(ns, sensor.frame_id, model, sensor)
             info_pub.publish(info)
             dinfo_pub.publish(info)
             pts = depth_to_points(depth, p.horizontal_fov)

@@ -123,6 +123,19 @@ def _mount(model: RobotModel, base: str, sensor: GazeboSensor) -> Transform3:
     return (~poses[base]) * poses[sensor.reference_link] * sensor.pose
 
 
+def _plumb_bob(
+    spec: CameraPluginSpec | KinectPluginSpec,
+) -> tuple[float, float, float, float, float]:
+    """CameraInfo ``d`` as GazeboRosCameraUtils fills it: k1, k2, t1, t2, k3."""
+    return (
+        spec.distortion_k1,
+        spec.distortion_k2,
+        spec.distortion_t1,
+        spec.distortion_t2,
+        spec.distortion_k3,
+    )
+
+
 def _rate(plugin_rate: float, sensor_rate: float, default: float) -> float:
     for r in (plugin_rate, sensor_rate):
         if r > 0:
@@ -240,6 +253,8 @@ def sim_config_from_model(model: RobotModel) -> RobotSimConfig:
                         frame_id=kin.frame_id,
                         point_cloud_cutoff=kin.point_cloud_cutoff_m,
                         point_cloud_cutoff_max=kin.point_cloud_cutoff_max_m,
+                        distortion=_plumb_bob(kin),
+                        hack_baseline_m=kin.hack_baseline,
                     )
                 )
             elif cam is not None:
@@ -252,6 +267,8 @@ def sim_config_from_model(model: RobotModel) -> RobotSimConfig:
                         image_topic=cam.image_topic,
                         info_topic=cam.camera_info_topic,
                         frame_id=cam.frame_id,
+                        distortion=_plumb_bob(cam),
+                        hack_baseline_m=cam.hack_baseline,
                     )
                 )
     imus: list[ImuSensor] = []

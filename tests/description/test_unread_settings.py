@@ -1,0 +1,49 @@
+"""Settings a robot file gives that the simulation does not act on are named (notes for
+what Gazebo's physics or Gazebo itself ignores too, warnings for what Gazebo would show
+and roverlab does not); what it does act on is read under Gazebo's names."""
+
+from __future__ import annotations
+
+from roverlab.description import CameraPluginSpec, KinectPluginSpec, load_robot
+from roverlab.description.check import format_check, robot_notes
+from tests.description.conftest import robot
+
+_CAM_LINK = '<link name="cam"/>'
+
+
+def _camera(sensor_type: str, plugin: str, params: str) -> str:
+    return robot(
+        f'{_CAM_LINK}<gazebo reference="cam"><sensor type="{sensor_type}" name="c">'
+        f'<plugin name="p" filename="{plugin}">{params}</plugin></sensor></gazebo>'
+    )
+
+
+def test_camera_plugins_read_gazebo_s_names_and_note_the_others() -> None:
+    # GazeboRosCameraUtils reads hackBaseline and distortionK1..T2 (both plugins); the
+    # <baseline> and distortion_k1 of tutorials are read by nothing, in Gazebo too
+    kinect = load_robot(
+        _camera(
+            "depth",
+            "libgazebo_ros_openni_kinect.so",
+            "<baseline>0.1</baseline><distortion_k1>0.2</distortion_k1>"
+            "<distortionK2>0.3</distortionK2>",
+        )
+    )
+    (k,) = kinect.gazebo.specs(KinectPluginSpec)
+    assert (k.hack_baseline, k.distortion_k1, k.distortion_k2) == (0.0, 0.0, 0.3)
+    (note,) = robot_notes(kinect)
+    assert "<plugin libgazebo_ros_openni_kinect.so> on sensor 'c': baseline, distortion_k1 " in (
+        note
+    )
+    assert "not read by the plugin (Gazebo ignores them too" in note
+    assert "note: " + note in format_check(kinect).splitlines()
+    camera = load_robot(
+        _camera(
+            "camera",
+            "libgazebo_ros_camera.so",
+            "<hackBaseline>0.07</hackBaseline><distortionK1>-0.1</distortionK1>",
+        )
+    )
+    (c,) = camera.gazebo.specs(CameraPluginSpec)
+    assert (c.hack_baseline, c.distortion_k1) == (0.07, -0.1)
+    assert robot_notes(camera) == []
