@@ -47,3 +47,22 @@ def test_camera_plugins_read_gazebo_s_names_and_note_the_others() -> None:
     (c,) = camera.gazebo.specs(CameraPluginSpec)
     assert (c.hack_baseline, c.distortion_k1) == (0.07, -0.1)
     assert robot_notes(camera) == []
+
+
+def _imu_plugin(params: str) -> str:
+    return robot(
+        '<link name="imu"/><gazebo><plugin name="imu" filename="libgazebo_ros_imu.so">'
+        f"<bodyName>imu</bodyName>{params}</plugin></gazebo>"
+    )
+
+
+def test_imu_xyz_offset_is_noted_and_rpy_offset_listed() -> None:
+    # gazebo_ros_imu: pos = pose.Pos() + offset_.Pos(), then never published (the Imu
+    # message has no position); gazebo_ros_imu_sensor: "POSITION OFFSET, UNUSED"
+    moved = load_robot(_imu_plugin("<xyzOffset>0 0 0.1</xyzOffset>"))
+    (note,) = robot_notes(moved)
+    assert "<plugin libgazebo_ros_imu.so>: xyzOffset has no effect" in note
+    assert robot_notes(load_robot(_imu_plugin("<xyzOffset>0 0 0</xyzOffset>"))) == []
+    turned = load_robot(_imu_plugin("<rpyOffset>3.14159 0 0</rpyOffset>"))
+    assert robot_notes(turned) == []  # simulated (tests/sim/test_plugin_options.py)
+    assert ", rpyOffset 3.14159 0 0" in format_check(turned)

@@ -12,7 +12,10 @@ import pytest
 
 from roverlab.core import Context
 from roverlab.description import load_robot
+from roverlab.geometry import quat_from_rpy, quat_from_yaw, quat_multiply, quat_rotate
 from roverlab.sim.app import Simulation
+from roverlab.sim.node import SpawnPose
+from roverlab.sim.sensors import GRAVITY
 from tests.description.conftest import robot
 
 LINKS = (
@@ -88,3 +91,68 @@ def test_camera_info_carries_the_plugins_distortion_and_hack_baseline() -> None:
         kinect = got[topic][-1]
         np.testing.assert_array_equal(kinect.d, [0.3, 0.0, 0.0, 0.0, 0.0])
         assert kinect.p[3] == pytest.approx(-fk * 0.075)
+
+
+def _imus(offset: str) -> str:
+    return f"""
+<gazebo>
+  <plugin name="imu_a" filename="libgazebo_ros_imu.so">
+    <bodyName>imu</bodyName><frameName>imu</frameName><topicName>imu_a</topicName>
+    <updateRate>50</updateRate>{offset}
+  </plugin>
+</gazebo>
+<gazebo reference="imu">
+  <sensor type="imu" name="imu_sensor">
+    <update_rate>50</update_rate>
+    <plugin name="imu_b" filename="libgazebo_ros_imu_sensor.so">
+      <robotNamespace>/</robotNamespace><topicName>imu_b</topicName>
+      <frameName>imu</frameName><updateRateHZ>50</updateRateHZ>{offset}
+    </plugin>
+  </sensor>
+</gazebo>
+"""
+
+
+def _last_imus(offset: str, yaw: float) -> tuple[Any, Any]:
+    ctx = Context()
+    Simulation(
+        context=ctx,
+        world="empty",
+        robot=load_robot(robot(LINKS + _imus(offset))),
+        spawn=SpawnPose(0.0, 0.0, yaw),
+        cameras=False,
+    )
+    imu = "sensor_msgs/msg/Imu"
+    got = _collect(ctx, {"/imu_a": imu, "/imu_b": imu})
+    ctx.spin_for(0.2)
+    return got["/imu_a"][-1], got["/imu_b"][-1]
+
+
+def _vec(v: Any) -> list[float]:
+    return [v.x, v.y, v.z]
+
+
+def test_imu_rpy_offset_turns_the_orientation_and_the_model_plugin_s_rates() -> None:
+    # gazebo_ros_imu: rot = offset.Rot() * link pose; orientation = rot, and the rates
+    # and accelerations are turned by rot; gazebo_ros_imu_sensor: orientation =
+    # offset.rot * sensor orientation, rates as measured
+    rpy, yaw = (0.3, -0.2, 0.5), 0.7
+    model_plugin, sensor_plugin = _last_imus(
+        f"<rpyOffset>{' '.join(map(str, rpy))}</rpyOffset>", yaw
+    )
+    q = quat_multiply(quat_from_rpy(*rpy), quat_from_yaw(yaw))
+    for msg in (model_plugin, sensor_plugin):
+        o = msg.orientation
+        np.testing.assert_allclose([o.x, o.y, o.z, o.w], q, atol=1e-12)
+    # at rest: gravity up in the body frame, turned by the offset for the model plugin
+    up = np.array([0.0, 0.0, GRAVITY])
+    np.testing.assert_allclose(
+        _vec(model_plugin.linear_acceleration), quat_rotate(quat_from_rpy(*rpy), up), atol=1e-9
+    )
+    np.testing.assert_allclose(_vec(sensor_plugin.linear_acceleration), up, atol=1e-9)
+    # a zero offset is the plugins' default: the body's yaw, unturned rates
+    plain_a, plain_b = _last_imus("<rpyOffset>0 0 0</rpyOffset>", yaw)
+    for msg in (plain_a, plain_b):
+        o = msg.orientation
+        np.testing.assert_allclose([o.x, o.y, o.z, o.w], quat_from_yaw(yaw), atol=1e-12)
+        np.testing.assert_allclose(_vec(msg.linear_acceleration), up, atol=1e-9)

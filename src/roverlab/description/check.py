@@ -101,6 +101,12 @@ def robot_notes(model: RobotModel, *, detail: bool = False) -> list[str]:
             f"{src}: <gazebo> model settings not simulated: " + ", ".join(model.gazebo.model_params)
         )
     out += _camera_notes(model)
+    out += [
+        f"{src}: <plugin {p.filename}>: xyzOffset has no effect (sensor_msgs/Imu has no "
+        "position: Gazebo's plugin adds the offset to a position it does not publish)"
+        for p in model.gazebo.plugins
+        if isinstance(p.spec, ImuPluginSpec) and any(p.spec.xyz_offset)
+    ]
     return out
 
 
@@ -265,6 +271,8 @@ def _plugin_line(p: GazeboPlugin) -> str:
             detail += f", gaussianNoise {_num(spec.gaussian_noise)}"
         if p.filename == "libgazebo_ros_imu_sensor.so":  # its 1 Hz default surprises
             detail += f", {_num(spec.update_rate_hz)} Hz" if spec.update_rate_hz else ""
+        if any(spec.rpy_offset):
+            detail += ", rpyOffset " + " ".join(_num(a) for a in spec.rpy_offset)
     else:
         detail = ": not supported by roverlab (ignored)"
     return head + detail

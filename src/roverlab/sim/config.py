@@ -98,6 +98,12 @@ class ImuSensor:
     update_rate_hz: float  # 0 = every physics step
     topic: str
     frame_id: str
+    rpy_offset: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    """The plugin's ``rpyOffset`` (rad): the orientation published is the offset's
+    rotation times the body's (both IMU plugins)."""
+    offset_turns_rates: bool = False
+    """``libgazebo_ros_imu.so`` turns the angular velocity and linear acceleration by the
+    ``rpyOffset`` rotation too; ``libgazebo_ros_imu_sensor.so`` does not."""
 
 
 @dataclass(frozen=True)

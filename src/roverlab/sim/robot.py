@@ -272,7 +272,10 @@ def sim_config_from_model(model: RobotModel) -> RobotSimConfig:
                     )
                 )
     imus: list[ImuSensor] = []
-    for spec in gz.specs(ImuPluginSpec):
+    for imu_plugin in gz.plugins:
+        spec = imu_plugin.spec
+        if not isinstance(spec, ImuPluginSpec):
+            continue
         noise = spec.noise
         imus.append(
             ImuSensor(
@@ -283,6 +286,8 @@ def sim_config_from_model(model: RobotModel) -> RobotSimConfig:
                 update_rate_hz=spec.update_rate_hz,
                 topic=spec.topic,
                 frame_id=spec.frame_id,
+                rpy_offset=spec.rpy_offset,
+                offset_turns_rates=imu_plugin.filename == "libgazebo_ros_imu.so",
             )
         )
     return RobotSimConfig(
