@@ -5,7 +5,7 @@ and roverlab does not); what it does act on is read under Gazebo's names."""
 from __future__ import annotations
 
 from roverlab.description import CameraPluginSpec, KinectPluginSpec, load_robot
-from roverlab.description.check import format_check, robot_notes
+from roverlab.description.check import format_check, robot_notes, robot_warnings
 from tests.description.conftest import robot
 
 _CAM_LINK = '<link name="cam"/>'
@@ -66,3 +66,30 @@ def test_imu_xyz_offset_is_noted_and_rpy_offset_listed() -> None:
     turned = load_robot(_imu_plugin("<rpyOffset>3.14159 0 0</rpyOffset>"))
     assert robot_notes(turned) == []  # simulated (tests/sim/test_plugin_options.py)
     assert ", rpyOffset 3.14159 0 0" in format_check(turned)
+
+
+def _ray(vertical: str, plugin: str = "libgazebo_ros_laser.so") -> str:
+    return robot(
+        '<link name="laser"/><gazebo reference="laser"><sensor type="ray" name="velo">'
+        "<ray><scan><horizontal><samples>360</samples><min_angle>-3.14159</min_angle>"
+        f"<max_angle>3.14159</max_angle></horizontal>{vertical}</scan>"
+        "<range><min>0.3</min><max>30</max></range></ray>"
+        f'<plugin name="p" filename="{plugin}"><topicName>scan</topicName></plugin>'
+        "</sensor></gazebo>"
+    )
+
+
+def test_a_multi_row_laser_is_warned_about() -> None:
+    # gazebo_ros_laser copies every range of the Gazebo scan (all rows, one after the
+    # other) into one LaserScan; roverlab scans one level row
+    rows = (
+        "<vertical><samples>16</samples><min_angle>-0.26</min_angle>"
+        "<max_angle>0.26</max_angle></vertical>"
+    )
+    (w,) = [w for w in robot_warnings(load_robot(_ray(rows))) if "<vertical>" in w]
+    assert "sensor 'velo': <vertical> samples 16 not simulated: only one level row" in w
+    assert "libgazebo_ros_laser.so publishes the 16 rows" in w
+    assert "one LaserScan of 5760 ranges" in w
+    # one vertical sample is Gazebo's level row (pitch 0, whatever its angles)
+    one = "<vertical><samples>1</samples><min_angle>-0.2</min_angle></vertical>"
+    assert not [w for w in robot_warnings(load_robot(_ray(one))) if "<vertical>" in w]

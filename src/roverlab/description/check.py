@@ -63,6 +63,7 @@ def robot_warnings(model: RobotModel) -> list[str]:
         out.append(f"{src}: Gazebo sensor types not simulated (ignored): {', '.join(sensors)}")
     out += _shape_warnings(model)
     out += _drive_warnings(model)
+    out += _ray_warnings(model)
     unknown = [r for r in model.gazebo.references if r not in model.links and r not in model.joints]
     if unknown:
         out.append(
@@ -158,6 +159,27 @@ def _drive_warnings(model: RobotModel) -> list[str]:
                 f"{where}: legacyMode true swaps the wheels' speeds in Gazebo (an old bug "
                 "kept for old URDFs); the simulated joint states report each wheel's own"
             )
+    return out
+
+
+def _ray_warnings(model: RobotModel) -> list[str]:
+    """Multi-row ray sensors published by a laser plugin: roverlab scans one level row."""
+    out: list[str] = []
+    for sensor in model.gazebo.sensors:
+        r = sensor.ray
+        if r is None or r.vertical is None or r.vertical.samples <= 1:
+            continue
+        laser = [p.filename for p in sensor.plugins if isinstance(p.spec, LaserPluginSpec)]
+        if not laser:
+            continue  # nothing published in ROS either
+        rows = r.vertical.range_count
+        out.append(
+            f"{model.source}: sensor '{sensor.name}': <vertical> samples {r.vertical.samples} "
+            f"not simulated: only one level row of {r.range_count} rays is scanned (Gazebo's "
+            f"{laser[0]} publishes the {rows} rows, "
+            f"{_num(r.vertical.min_angle)} to {_num(r.vertical.max_angle)} rad, one after "
+            f"another in one LaserScan of {rows * r.range_count} ranges)"
+        )
     return out
 
 
