@@ -93,3 +93,38 @@ def test_a_multi_row_laser_is_warned_about() -> None:
     # one vertical sample is Gazebo's level row (pitch 0, whatever its angles)
     one = "<vertical><samples>1</samples><min_angle>-0.2</min_angle></vertical>"
     assert not [w for w in robot_warnings(load_robot(_ray(one))) if "<vertical>" in w]
+
+
+_WHEEL = (
+    '<inertial><mass value="0.5"/>'
+    '<inertia ixx="1e-3" ixy="0" ixz="0" iyy="1e-3" iyz="0" izz="2e-3"/></inertial>'
+)
+
+
+def test_inertia_joint_dynamics_and_safety_controller_are_one_note() -> None:
+    m = load_robot(
+        robot(
+            f'<link name="base">{_WHEEL}</link><link name="left">{_WHEEL}</link>'
+            '<link name="right"/><link name="arm"/>'
+            '<joint name="l" type="continuous"><parent link="base"/><child link="left"/>'
+            '<dynamics damping="0.1" friction="0.05"/></joint>'
+            '<joint name="r" type="continuous"><parent link="base"/><child link="right"/>'
+            '<dynamics damping="0" friction="0"/></joint>'
+            '<joint name="a" type="revolute"><parent link="base"/><child link="arm"/>'
+            '<limit lower="-1" upper="1" effort="1" velocity="1"/>'
+            '<safety_controller k_velocity="10" soft_lower_limit="-0.9" soft_upper_limit="0.9"/>'
+            "</joint>"
+        )
+    )
+    (note,) = robot_notes(m)
+    assert note.endswith(
+        "settings of Gazebo's dynamics not simulated (the body moves kinematically; only "
+        "link masses are read, for wheelTorque): <inertial> inertia and centre of mass of 2 links; "
+        "<dynamics> damping and friction of 1 joint; <safety_controller> of 1 joint"
+    ), note
+    (detail,) = robot_notes(m, detail=True)
+    assert detail.endswith(
+        "<inertial> inertia and centre of mass (base, left); <dynamics> damping and friction "
+        "(l); <safety_controller> (a)"
+    ), detail
+    assert "note: " + detail in format_check(m).splitlines()

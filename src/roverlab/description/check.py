@@ -74,12 +74,15 @@ def robot_warnings(model: RobotModel) -> list[str]:
 
 
 def robot_notes(model: RobotModel, *, detail: bool = False) -> list[str]:
-    """``<gazebo>`` settings of the robot that Gazebo's physics uses and the 2D simulator
-    does not, by name: ODE friction and contact parameters of the links (``mu1``, ``kp``,
-    ``selfCollide``...), other simple elements of a ``<gazebo reference>``, and the
-    model-level ones (``static``...). Only ``material`` (the dashboard's colour) is read
-    from a reference. Notes, not warnings: the bundled robots set them for Gazebo too, and
-    nothing the simulation does depends on them. ``detail`` names the links of each."""
+    """Settings of the robot that Gazebo's physics uses and the 2D simulator does not, by
+    name: ODE friction and contact parameters of the links (``mu1``, ``kp``,
+    ``selfCollide``...), other simple elements of a ``<gazebo reference>``, the
+    model-level ones (``static``...), inertia tensors, joint ``<dynamics>`` and
+    ``<safety_controller>``; and plugin elements Gazebo does not read either (a camera's
+    ``<baseline>``, an IMU's ``xyzOffset``). Only ``material`` (the dashboard's colour) is
+    read from a reference. Notes, not warnings: the bundled robots set them for Gazebo
+    too, and nothing the simulation does depends on them. ``detail`` names the links (and
+    joints) of each."""
     src = model.source
     settings: dict[str, list[str]] = {}
     for name, ref in model.gazebo.references.items():
@@ -101,6 +104,7 @@ def robot_notes(model: RobotModel, *, detail: bool = False) -> list[str]:
         out.append(
             f"{src}: <gazebo> model settings not simulated: " + ", ".join(model.gazebo.model_params)
         )
+    out += _physics_notes(model, detail)
     out += _camera_notes(model)
     out += [
         f"{src}: <plugin {p.filename}>: xyzOffset has no effect (sensor_msgs/Imu has no "
@@ -109,6 +113,38 @@ def robot_notes(model: RobotModel, *, detail: bool = False) -> list[str]:
         if isinstance(p.spec, ImuPluginSpec) and any(p.spec.xyz_offset)
     ]
     return out
+
+
+def _physics_notes(model: RobotModel, detail: bool) -> list[str]:
+    """URDF settings for Gazebo's dynamics: links' inertia tensors and centres of mass
+    (the masses are read: they bound the drive's acceleration under ``wheelTorque``),
+    joints' ``<dynamics>`` damping and friction, ``<safety_controller>`` soft limits."""
+    found = {
+        "<inertial> inertia and centre of mass": [
+            name for name, link in model.links.items() if link.inertial is not None
+        ],
+        "<dynamics> damping and friction": [
+            name
+            for name, j in model.joints.items()
+            if j.dynamics is not None and (j.dynamics.damping or j.dynamics.friction)
+        ],
+        "<safety_controller>": [name for name, j in model.joints.items() if j.safety is not None],
+    }
+    parts = []
+    for what, names in found.items():
+        if not names:
+            continue
+        kind = "link" if what.startswith("<inertial>") else "joint"
+        if detail:
+            parts.append(f"{what} ({', '.join(names)})")
+        else:
+            parts.append(f"{what} of {len(names)} {kind}{'s' if len(names) != 1 else ''}")
+    if not parts:
+        return []
+    return [
+        f"{model.source}: settings of Gazebo's dynamics not simulated (the body moves "
+        f"kinematically; only link masses are read, for wheelTorque): {'; '.join(parts)}"
+    ]
 
 
 # names tutorials give camera plugins that GazeboRosCameraUtils reads under other names

@@ -397,8 +397,11 @@ class GazeboSensor:
     """A ``<sensor>`` of link ``reference_link`` with SDF's defaults for missing elements.
 
     ``pose`` is the sensor frame in the link frame; ``params`` holds other simple child
-    elements (``topic``, ...). Exactly one of ``ray``/``camera``/``imu`` is set for the
-    supported types (``ray``/``gpu_ray``, ``camera``/``depth``, ``imu``).
+    elements (``topic``, ...). ``always_on`` changes nothing in ROS: the gazebo_ros
+    plugins switch their sensor on themselves (camera and laser while subscribed, the imu
+    sensor plugin at load), so the simulator does too. Exactly one of ``ray``/``camera``/
+    ``imu`` is set for the supported types (``ray``/``gpu_ray``, ``camera``/``depth``,
+    ``imu``).
     """
 
     name: str
