@@ -128,3 +128,21 @@ def test_inertia_joint_dynamics_and_safety_controller_are_one_note() -> None:
         "(l); <safety_controller> (a)"
     ), detail
     assert "note: " + detail in format_check(m).splitlines()
+
+
+def test_sdf_lens_distortion_is_warned_about() -> None:
+    # Gazebo distorts the rendered image by the SDF <camera><distortion>; roverlab does not
+    def cam(distortion: str) -> str:
+        return robot(
+            f'{_CAM_LINK}<gazebo reference="cam"><sensor type="camera" name="fisheye">'
+            f"<camera>{distortion}</camera></sensor></gazebo>"
+        )
+
+    lens = "<distortion><k1>-0.25</k1><p2>0.001</p2><center>0.5 0.5</center></distortion>"
+    m = load_robot(cam(lens))
+    camera = m.gazebo.sensor("fisheye").camera
+    assert camera is not None and camera.lens_distortion == (-0.25, 0.0, 0.0, 0.0, 0.001)
+    (w,) = [w for w in robot_warnings(m) if "distortion" in w]
+    assert "sensor 'fisheye': <camera><distortion> not simulated" in w
+    flat = load_robot(cam("<distortion><k1>0</k1></distortion>"))
+    assert not [w for w in robot_warnings(flat) if "distortion" in w]

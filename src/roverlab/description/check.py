@@ -64,6 +64,12 @@ def robot_warnings(model: RobotModel) -> list[str]:
     out += _shape_warnings(model)
     out += _drive_warnings(model)
     out += _ray_warnings(model)
+    out += [
+        f"{src}: sensor '{s.name}': <camera><distortion> not simulated: the image is "
+        "rendered without lens distortion (Gazebo distorts it)"
+        for s in model.gazebo.sensors
+        if s.camera is not None and any(s.camera.lens_distortion or ())
+    ]
     unknown = [r for r in model.gazebo.references if r not in model.links and r not in model.joints]
     if unknown:
         out.append(

@@ -136,6 +136,12 @@ def _ray(elem: ET.Element, where: str) -> RaySpec:
     return spec
 
 
+def _lens_distortion(v: ElementValues) -> tuple[float, float, float, float, float]:
+    """SDF ``<camera><distortion>``: k1, k2, k3, p1, p2 (default 0)."""
+    k1, k2, k3, p1, p2 = (v.number(f"distortion/{k}", 0.0) for k in ("k1", "k2", "k3", "p1", "p2"))
+    return (k1, k2, k3, p1, p2)
+
+
 def _camera(elem: ET.Element, where: str) -> CameraSpec:
     v = ElementValues(flatten_element(elem), where + ": <camera>")
     spec = CameraSpec(
@@ -149,6 +155,7 @@ def _camera(elem: ET.Element, where: str) -> CameraSpec:
         noise_stddev=v.non_negative("noise/stddev", 0.0),
         noise_type=v.noise_type("noise/type"),
         name=elem.get("name", ""),
+        lens_distortion=_lens_distortion(v) if elem.find("distortion") is not None else None,
     )
     if not 0.0 < spec.horizontal_fov < math.pi:
         raise v.fail("horizontal_fov", f"{spec.horizontal_fov:g} rad is not in (0, pi)")

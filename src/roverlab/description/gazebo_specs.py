@@ -170,6 +170,9 @@ class CameraSpec:
     noise_stddev: float = 0.0
     noise_type: str = "none"
     name: str = ""
+    lens_distortion: tuple[float, float, float, float, float] | None = None
+    """SDF ``<distortion>`` (k1, k2, k3, p1, p2), which Gazebo applies to the rendered
+    image; roverlab renders undistorted (``robot_warnings`` says so when it is not zero)."""
 
     @property
     def focal_length_px(self) -> float:
