@@ -273,6 +273,8 @@ def test_mycar_sensors_and_plugins() -> None:
         0.4,
         10.0,
     )
+    # <baseline> is read by neither Gazebo's plugin nor roverlab: P[3] comes from hackBaseline
+    assert k.hack_baseline == 0.0
 
 
 def test_mycar_rviz_config_lists_the_robot_links() -> None:

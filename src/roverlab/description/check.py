@@ -16,6 +16,7 @@ then the sensors and plugins, each marked supported or not by roverlab.
 from __future__ import annotations
 
 import math
+from typing import Final
 
 from roverlab.description.errors import DescriptionError
 from roverlab.description.gazebo import REFERENCE_KEYS
@@ -62,6 +63,13 @@ def robot_warnings(model: RobotModel) -> list[str]:
         out.append(f"{src}: Gazebo sensor types not simulated (ignored): {', '.join(sensors)}")
     out += _shape_warnings(model)
     out += _drive_warnings(model)
+    out += _ray_warnings(model)
+    out += [
+        f"{src}: sensor '{s.name}': <camera><distortion> not simulated: the image is "
+        "rendered without lens distortion (Gazebo distorts it)"
+        for s in model.gazebo.sensors
+        if s.camera is not None and any(s.camera.lens_distortion or ())
+    ]
     unknown = [r for r in model.gazebo.references if r not in model.links and r not in model.joints]
     if unknown:
         out.append(
@@ -72,12 +80,15 @@ def robot_warnings(model: RobotModel) -> list[str]:
 
 
 def robot_notes(model: RobotModel, *, detail: bool = False) -> list[str]:
-    """``<gazebo>`` settings of the robot that Gazebo's physics uses and the 2D simulator
-    does not, by name: ODE friction and contact parameters of the links (``mu1``, ``kp``,
-    ``selfCollide``...), other simple elements of a ``<gazebo reference>``, and the
-    model-level ones (``static``...). Only ``material`` (the dashboard's colour) is read
-    from a reference. Notes, not warnings: the bundled robots set them for Gazebo too, and
-    nothing the simulation does depends on them. ``detail`` names the links of each."""
+    """Settings of the robot that Gazebo's physics uses and the 2D simulator does not, by
+    name: ODE friction and contact parameters of the links (``mu1``, ``kp``,
+    ``selfCollide``...), other simple elements of a ``<gazebo reference>``, the
+    model-level ones (``static``...), inertia tensors, joint ``<dynamics>`` and
+    ``<safety_controller>``; and plugin elements Gazebo does not read either (a camera's
+    ``<baseline>``, an IMU's ``xyzOffset``). Only ``material`` (the dashboard's colour) is
+    read from a reference. Notes, not warnings: the bundled robots set them for Gazebo
+    too, and nothing the simulation does depends on them. ``detail`` names the links (and
+    joints) of each."""
     src = model.source
     settings: dict[str, list[str]] = {}
     for name, ref in model.gazebo.references.items():
@@ -99,6 +110,68 @@ def robot_notes(model: RobotModel, *, detail: bool = False) -> list[str]:
         out.append(
             f"{src}: <gazebo> model settings not simulated: " + ", ".join(model.gazebo.model_params)
         )
+    out += _physics_notes(model, detail)
+    out += _camera_notes(model)
+    out += [
+        f"{src}: <plugin {p.filename}>: xyzOffset has no effect (sensor_msgs/Imu has no "
+        "position: Gazebo's plugin adds the offset to a position it does not publish)"
+        for p in model.gazebo.plugins
+        if isinstance(p.spec, ImuPluginSpec) and any(p.spec.xyz_offset)
+    ]
+    return out
+
+
+def _physics_notes(model: RobotModel, detail: bool) -> list[str]:
+    """URDF settings for Gazebo's dynamics: links' inertia tensors and centres of mass
+    (the masses are read: they bound the drive's acceleration under ``wheelTorque``),
+    joints' ``<dynamics>`` damping and friction, ``<safety_controller>`` soft limits."""
+    found = {
+        "<inertial> inertia and centre of mass": [
+            name for name, link in model.links.items() if link.inertial is not None
+        ],
+        "<dynamics> damping and friction": [
+            name
+            for name, j in model.joints.items()
+            if j.dynamics is not None and (j.dynamics.damping or j.dynamics.friction)
+        ],
+        "<safety_controller>": [name for name, j in model.joints.items() if j.safety is not None],
+    }
+    parts = []
+    for what, names in found.items():
+        if not names:
+            continue
+        kind = "link" if what.startswith("<inertial>") else "joint"
+        if detail:
+            parts.append(f"{what} ({', '.join(names)})")
+        else:
+            parts.append(f"{what} of {len(names)} {kind}{'s' if len(names) != 1 else ''}")
+    if not parts:
+        return []
+    return [
+        f"{model.source}: settings of Gazebo's dynamics not simulated (the body moves "
+        f"kinematically; only link masses are read, for wheelTorque): {'; '.join(parts)}"
+    ]
+
+
+# names tutorials give camera plugins that GazeboRosCameraUtils reads under other names
+_CAMERA_MISNAMED: Final = ("baseline", *(f"distortion_{k}" for k in ("k1", "k2", "k3", "t1", "t2")))
+
+
+def _camera_notes(model: RobotModel) -> list[str]:
+    """Camera plugin elements that Gazebo's plugin does not read either (so the published
+    CameraInfo ignores them there too): ``<baseline>`` and ``distortion_k1``..."""
+    out: list[str] = []
+    for plugin in model.gazebo.plugins:
+        if not isinstance(plugin.spec, CameraPluginSpec | KinectPluginSpec):
+            continue
+        unread = [k for k in _CAMERA_MISNAMED if k in plugin.params]
+        if unread:
+            out.append(
+                f"{model.source}: <plugin {plugin.filename}> on sensor '{plugin.reference}': "
+                f"{', '.join(unread)} not read by the plugin (Gazebo ignores them too; "
+                "CameraInfo's P[3] comes from hackBaseline, its D from distortionK1, "
+                "distortionK2, distortionT1, distortionT2, distortionK3)"
+            )
     return out
 
 
@@ -128,6 +201,27 @@ def _drive_warnings(model: RobotModel) -> list[str]:
                 f"{where}: legacyMode true swaps the wheels' speeds in Gazebo (an old bug "
                 "kept for old URDFs); the simulated joint states report each wheel's own"
             )
+    return out
+
+
+def _ray_warnings(model: RobotModel) -> list[str]:
+    """Multi-row ray sensors published by a laser plugin: roverlab scans one level row."""
+    out: list[str] = []
+    for sensor in model.gazebo.sensors:
+        r = sensor.ray
+        if r is None or r.vertical is None or r.vertical.samples <= 1:
+            continue
+        laser = [p.filename for p in sensor.plugins if isinstance(p.spec, LaserPluginSpec)]
+        if not laser:
+            continue  # nothing published in ROS either
+        rows = r.vertical.range_count
+        out.append(
+            f"{model.source}: sensor '{sensor.name}': <vertical> samples {r.vertical.samples} "
+            f"not simulated: only one level row of {r.range_count} rays is scanned (Gazebo's "
+            f"{laser[0]} publishes the {rows} rows, "
+            f"{_num(r.vertical.min_angle)} to {_num(r.vertical.max_angle)} rad, one after "
+            f"another in one LaserScan of {rows * r.range_count} ranges)"
+        )
     return out
 
 
@@ -241,6 +335,8 @@ def _plugin_line(p: GazeboPlugin) -> str:
             detail += f", gaussianNoise {_num(spec.gaussian_noise)}"
         if p.filename == "libgazebo_ros_imu_sensor.so":  # its 1 Hz default surprises
             detail += f", {_num(spec.update_rate_hz)} Hz" if spec.update_rate_hz else ""
+        if any(spec.rpy_offset):
+            detail += ", rpyOffset " + " ".join(_num(a) for a in spec.rpy_offset)
     else:
         detail = ": not supported by roverlab (ignored)"
     return head + detail

@@ -136,6 +136,12 @@ def _ray(elem: ET.Element, where: str) -> RaySpec:
     return spec
 
 
+def _lens_distortion(v: ElementValues) -> tuple[float, float, float, float, float]:
+    """SDF ``<camera><distortion>``: k1, k2, k3, p1, p2 (default 0)."""
+    k1, k2, k3, p1, p2 = (v.number(f"distortion/{k}", 0.0) for k in ("k1", "k2", "k3", "p1", "p2"))
+    return (k1, k2, k3, p1, p2)
+
+
 def _camera(elem: ET.Element, where: str) -> CameraSpec:
     v = ElementValues(flatten_element(elem), where + ": <camera>")
     spec = CameraSpec(
@@ -149,6 +155,7 @@ def _camera(elem: ET.Element, where: str) -> CameraSpec:
         noise_stddev=v.non_negative("noise/stddev", 0.0),
         noise_type=v.noise_type("noise/type"),
         name=elem.get("name", ""),
+        lens_distortion=_lens_distortion(v) if elem.find("distortion") is not None else None,
     )
     if not 0.0 < spec.horizontal_fov < math.pi:
         raise v.fail("horizontal_fov", f"{spec.horizontal_fov:g} rad is not in (0, pi)")
@@ -242,16 +249,14 @@ def _laser(v: ElementValues, plugin: GazeboPlugin) -> LaserPluginSpec:
     )
 
 
-def _distortion(v: ElementValues, name: str) -> float:
-    """``distortionK1`` (what the camera utils read) or ``distortion_k1`` (seen in tutorials)."""
-    camel = "distortion" + name.upper()
-    snake = "distortion_" + name.lower()
-    return v.number(camel, v.number(snake, 0.0))
+_DISTORTION: Final = ("k1", "k2", "k3", "t1", "t2")
 
 
 def _distortions(v: ElementValues) -> dict[str, float]:
-    """The five ``distortion_*`` fields of a camera plugin spec."""
-    return {f"distortion_{k}": _distortion(v, k) for k in ("k1", "k2", "k3", "t1", "t2")}
+    """The five ``distortion_*`` fields of a camera plugin spec, from ``distortionK1``..
+    ``distortionT2`` (GazeboRosCameraUtils reads only these names: a ``distortion_k1``
+    seen in tutorials is ignored, and ``urdf check`` notes it)."""
+    return {f"distortion_{k}": v.number("distortion" + k.upper(), 0.0) for k in _DISTORTION}
 
 
 def _camera_plugin(v: ElementValues, plugin: GazeboPlugin) -> CameraPluginSpec:
@@ -284,7 +289,8 @@ def _kinect(v: ElementValues, plugin: GazeboPlugin) -> KinectPluginSpec:
             cns, v.text("depthImageCameraInfoTopicName", "depth/camera_info")
         ),
         frame_id=resolve_frame(ns, v.text("frameName", "/world")),
-        baseline=v.number("baseline", v.number("hackBaseline", 0.0)),
+        baseline=v.number("baseline", 0.0),
+        hack_baseline=v.number("hackBaseline", 0.0),
         point_cloud_cutoff_m=v.non_negative("pointCloudCutoff", 0.4),
         point_cloud_cutoff_max_m=v.non_negative("pointCloudCutoffMax", 5.0),
         update_rate_hz=v.non_negative("updateRate", 0.0),

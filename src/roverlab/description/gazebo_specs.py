@@ -170,6 +170,9 @@ class CameraSpec:
     noise_stddev: float = 0.0
     noise_type: str = "none"
     name: str = ""
+    lens_distortion: tuple[float, float, float, float, float] | None = None
+    """SDF ``<distortion>`` (k1, k2, k3, p1, p2), which Gazebo applies to the rendered
+    image; roverlab renders undistorted (``robot_warnings`` says so when it is not zero)."""
 
     @property
     def focal_length_px(self) -> float:
@@ -274,7 +277,12 @@ class LaserPluginSpec:
 
 @dataclass(frozen=True, slots=True)
 class CameraPluginSpec:
-    """``libgazebo_ros_camera.so`` (GazeboRosCameraUtils' defaults)."""
+    """``libgazebo_ros_camera.so`` (GazeboRosCameraUtils' defaults).
+
+    ``hack_baseline`` (m) and the ``distortion_*`` coefficients go into the published
+    CameraInfo only (``p[3] = -fx * hack_baseline``, ``d = [k1, k2, t1, t2, k3]``), as
+    GazeboRosCameraUtils puts them; the image is not distorted by them.
+    """
 
     camera_name: str = ""
     image_topic: str = "/image_raw"
@@ -292,7 +300,13 @@ class CameraPluginSpec:
 
 @dataclass(frozen=True, slots=True)
 class KinectPluginSpec:
-    """``libgazebo_ros_openni_kinect.so``: RGB, depth image, point cloud, camera infos."""
+    """``libgazebo_ros_openni_kinect.so``: RGB, depth image, point cloud, camera infos.
+
+    Its camera infos are GazeboRosCameraUtils', as the camera plugin's: ``hack_baseline``
+    (``hackBaseline``) and the ``distortion_*`` coefficients. ``baseline`` is the
+    ``<baseline>`` element tutorials put in the plugin: the plugin reads nothing by that
+    name (``urdf check`` notes it).
+    """
 
     camera_name: str = ""
     image_topic: str = "/ir/image_raw"
@@ -302,6 +316,7 @@ class KinectPluginSpec:
     depth_image_camera_info_topic: str = "/depth/camera_info"
     frame_id: str = "world"
     baseline: float = 0.0
+    hack_baseline: float = 0.0
     point_cloud_cutoff_m: float = 0.4
     point_cloud_cutoff_max_m: float = 5.0
     update_rate_hz: float = 0.0
@@ -385,8 +400,11 @@ class GazeboSensor:
     """A ``<sensor>`` of link ``reference_link`` with SDF's defaults for missing elements.
 
     ``pose`` is the sensor frame in the link frame; ``params`` holds other simple child
-    elements (``topic``, ...). Exactly one of ``ray``/``camera``/``imu`` is set for the
-    supported types (``ray``/``gpu_ray``, ``camera``/``depth``, ``imu``).
+    elements (``topic``, ...). ``always_on`` changes nothing in ROS: the gazebo_ros
+    plugins switch their sensor on themselves (camera and laser while subscribed, the imu
+    sensor plugin at load), so the simulator does too. Exactly one of ``ray``/``camera``/
+    ``imu`` is set for the supported types (``ray``/``gpu_ray``, ``camera``/``depth``,
+    ``imu``).
     """
 
     name: str

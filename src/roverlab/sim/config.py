@@ -98,6 +98,12 @@ class ImuSensor:
     update_rate_hz: float  # 0 = every physics step
     topic: str
     frame_id: str
+    rpy_offset: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    """The plugin's ``rpyOffset`` (rad): the orientation published is the offset's
+    rotation times the body's (both IMU plugins)."""
+    offset_turns_rates: bool = False
+    """``libgazebo_ros_imu.so`` turns the angular velocity and linear acceleration by the
+    ``rpyOffset`` rotation too; ``libgazebo_ros_imu_sensor.so`` does not."""
 
 
 @dataclass(frozen=True)
@@ -109,6 +115,11 @@ class CameraSensor:
     image_topic: str
     info_topic: str
     frame_id: str
+    distortion: tuple[float, float, float, float, float] = (0.0, 0.0, 0.0, 0.0, 0.0)
+    """CameraInfo ``d`` (plumb_bob: k1, k2, t1, t2, k3) from the plugin's ``distortionK1``..
+    ``distortionT2``: reported only, the image is not distorted (as in Gazebo)."""
+    hack_baseline_m: float = 0.0
+    """The plugin's ``hackBaseline``: CameraInfo ``p[3]`` (Tx) is ``-fx * hack_baseline_m``."""
 
 
 @dataclass(frozen=True)
@@ -127,6 +138,11 @@ class DepthSensor:
     frame_id: str
     point_cloud_cutoff: float = 0.0
     point_cloud_cutoff_max: float = float("inf")
+    distortion: tuple[float, float, float, float, float] = (0.0, 0.0, 0.0, 0.0, 0.0)
+    """CameraInfo ``d`` (plumb_bob: k1, k2, t1, t2, k3) from the plugin's ``distortionK1``..
+    ``distortionT2``: reported only, the image is not distorted (as in Gazebo)."""
+    hack_baseline_m: float = 0.0
+    """The plugin's ``hackBaseline``: CameraInfo ``p[3]`` (Tx) is ``-fx * hack_baseline_m``."""
 
 
 @dataclass(frozen=True)

@@ -9,6 +9,7 @@ parameter, so a seeded run is reproducible.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -16,7 +17,7 @@ import numpy as np
 
 from roverlab.core import Node
 from roverlab.core.node import pausing_timer
-from roverlab.geometry import Transform3, rpy_from_quat, wrap_angle
+from roverlab.geometry import Transform3, quat_from_rpy, quat_rotate, rpy_from_quat, wrap_angle
 from roverlab.msgs import builders as build
 from roverlab.msgs import classes as mc
 from roverlab.msgs import xyz_to_pointcloud2
@@ -433,6 +434,9 @@ class SimulatorNode(Node):
         rate = sensor.update_rate_hz if sensor.update_rate_hz > 0 else self.physics_rate
         cov = np.zeros(9)  # shared by the three fields of every message: read-only
         cov.flags.writeable = False
+        if any(sensor.rpy_offset):  # decided once: the usual tick below stays as lean
+            self.create_timer(1.0 / rate, self._imu_offset_tick(sensor, model, pub, cov))
+            return
 
         ex = self._executor
         frame = sensor.frame_id
@@ -477,17 +481,71 @@ class SimulatorNode(Node):
 
         self.create_timer(1.0 / rate, tick)
 
-    def _camera_info(self, ns: int, frame: str, model: CameraModel) -> Any:
+    def _imu_offset_tick(
+        self, sensor: ImuSensor, model: ImuModel, pub: Any, cov: np.ndarray
+    ) -> Callable[[], None]:
+        """The tick of an IMU plugin with an ``rpyOffset``, as the plugins apply it: the
+        orientation is ``q_offset * q_body``, and ``libgazebo_ros_imu.so`` turns the
+        angular velocity and linear acceleration by that rotation too (the sensor
+        plugin publishes them as measured)."""
+        ox, oy, oz, ow = (float(c) for c in quat_from_rpy(*sensor.rpy_offset))
+        turn = sensor.offset_turns_rates
+        # the offset's rotation matrix, row by row, as plain floats
+        (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = quat_rotate(
+            (ox, oy, oz, ow), np.eye(3)
+        ).T.tolist()
+        state = self._state_view
+        frame = sensor.frame_id
+        rows = iter(model.take_rows())
+
+        def tick() -> None:
+            nonlocal rows
+            self.advance()
+            n = next(rows, None)
+            if n is None:
+                rows = iter(model.take_rows())
+                n = next(rows)
+            half = 0.5 * state[S_TH]
+            s, c = math.sin(half), math.cos(half)
+            # q_offset * (0, 0, s, c)
+            qx, qy, qz, qw = ox * c + oy * s, oy * c - ox * s, ow * s + oz * c, ow * c - oz * s
+            wx, wy, wz = n[0], n[1], state[S_W] + n[2]
+            ax, ay, az = state[S_DV] + n[3], state[S_LAT] + n[4], n[5]
+            if turn:
+                wx, wy, wz = (
+                    r00 * wx + r01 * wy + r02 * wz,
+                    r10 * wx + r11 * wy + r12 * wz,
+                    r20 * wx + r21 * wy + r22 * wz,
+                )
+                ax, ay, az = (
+                    r00 * ax + r01 * ay + r02 * az,
+                    r10 * ax + r11 * ay + r12 * az,
+                    r20 * ax + r21 * ay + r22 * az,
+                )
+            sec, nsec = divmod(self._executor.now_ns, 1_000_000_000)
+            pub.publish(
+                build.imu(sec, nsec, frame, qx, qy, qz, qw, cov, wx, wy, wz, cov, ax, ay, az, cov)
+            )
+
+        return tick
+
+    def _camera_info(
+        self, ns: int, frame: str, model: CameraModel, sensor: CameraSensor | DepthSensor
+    ) -> Any:
+        # as GazeboRosCameraUtils: d from the plugin's distortion coefficients (reported,
+        # not applied to the image), p[3] = -fx * hackBaseline
         p = model.params
         k = camera_intrinsics(p.width, p.height, p.horizontal_fov).k
         proj = np.zeros((3, 4))
         proj[:, :3] = k
+        if sensor.hack_baseline_m:
+            proj[0, 3] = -k[0, 0] * sensor.hack_baseline_m
         return mc.CameraInfo(
             header=_header(ns, frame),
             height=p.height,
             width=p.width,
             distortion_model="plumb_bob",
-            d=np.zeros(5),
+            d=np.array(sensor.distortion, dtype=np.float64),
             k=k.reshape(-1),
             r=np.eye(3).reshape(-1),
             p=proj.reshape(-1),
@@ -511,7 +569,7 @@ class SimulatorNode(Node):
             x, y, z, yaw, pitch = self.sensor_pose(sensor.mount)
             rgb = model.capture_rgb(self.scene, x, y, z, yaw, pitch)
             image_pub.publish(_image(ns, sensor.frame_id, rgb, "rgb8"))
-            info_pub.publish(self._camera_info(ns, sensor.frame_id, model))
+            info_pub.publish(self._camera_info(ns, sensor.frame_id, model, sensor))
 
         self.create_timer(1.0 / sensor.update_rate_hz, tick)
 
@@ -534,7 +592,7 @@ class SimulatorNode(Node):
             rgb, depth = model.capture(self.scene, x, y, z, yaw, pitch)
             image_pub.publish(_image(ns, sensor.frame_id, rgb, "rgb8"))
             depth_pub.publish(_image(ns, sensor.frame_id, depth, "32FC1"))
-            info = self._camera_info(ns, sensor.frame_id, model)
+            info = self._camera_info(ns, sensor.frame_id, model, sensor)
             info_pub.publish(info)
             dinfo_pub.publish(info)
             pts = depth_to_points(depth, p.horizontal_fov)

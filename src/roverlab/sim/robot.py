@@ -123,6 +123,19 @@ def _mount(model: RobotModel, base: str, sensor: GazeboSensor) -> Transform3:
     return (~poses[base]) * poses[sensor.reference_link] * sensor.pose
 
 
+def _plumb_bob(
+    spec: CameraPluginSpec | KinectPluginSpec,
+) -> tuple[float, float, float, float, float]:
+    """CameraInfo ``d`` as GazeboRosCameraUtils fills it: k1, k2, t1, t2, k3."""
+    return (
+        spec.distortion_k1,
+        spec.distortion_k2,
+        spec.distortion_t1,
+        spec.distortion_t2,
+        spec.distortion_k3,
+    )
+
+
 def _rate(plugin_rate: float, sensor_rate: float, default: float) -> float:
     for r in (plugin_rate, sensor_rate):
         if r > 0:
@@ -240,6 +253,8 @@ def sim_config_from_model(model: RobotModel) -> RobotSimConfig:
                         frame_id=kin.frame_id,
                         point_cloud_cutoff=kin.point_cloud_cutoff_m,
                         point_cloud_cutoff_max=kin.point_cloud_cutoff_max_m,
+                        distortion=_plumb_bob(kin),
+                        hack_baseline_m=kin.hack_baseline,
                     )
                 )
             elif cam is not None:
@@ -252,10 +267,15 @@ def sim_config_from_model(model: RobotModel) -> RobotSimConfig:
                         image_topic=cam.image_topic,
                         info_topic=cam.camera_info_topic,
                         frame_id=cam.frame_id,
+                        distortion=_plumb_bob(cam),
+                        hack_baseline_m=cam.hack_baseline,
                     )
                 )
     imus: list[ImuSensor] = []
-    for spec in gz.specs(ImuPluginSpec):
+    for imu_plugin in gz.plugins:
+        spec = imu_plugin.spec
+        if not isinstance(spec, ImuPluginSpec):
+            continue
         noise = spec.noise
         imus.append(
             ImuSensor(
@@ -266,6 +286,8 @@ def sim_config_from_model(model: RobotModel) -> RobotSimConfig:
                 update_rate_hz=spec.update_rate_hz,
                 topic=spec.topic,
                 frame_id=spec.frame_id,
+                rpy_offset=spec.rpy_offset,
+                offset_turns_rates=imu_plugin.filename == "libgazebo_ros_imu.so",
             )
         )
     return RobotSimConfig(
