@@ -38,22 +38,33 @@ def _mesh_cache(tmp_path_factory: pytest.TempPathFactory) -> Iterator[None]:
         os.environ["ROVERLAB_CACHE_DIR"] = old
 
 
-@pytest.fixture(scope="session")
-def daemon(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
-    """A daemon on a free loopback port; ROVERLAB_DAEMON points every process at it."""
-    from roverlab.core.transport.daemon import ensure_daemon, stop_daemon
+@pytest.fixture(scope="session", autouse=True)
+def _private_daemon_endpoint(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
+    """ROVERLAB_DAEMON points every process of the session at a free loopback port of its
+    own, so no test can join (or start) the machine's default daemon, which a user's live
+    system may be using; a daemon something started there is stopped at the end."""
+    from roverlab.core.transport.daemon import stop_daemon
 
     endpoint = f"tcp/127.0.0.1:{free_port()}"
-    old = os.environ.get("ROVERLAB_DAEMON")
+    old = {k: os.environ.get(k) for k in ("ROVERLAB_DAEMON", "ROVERLAB_LOG_DIR")}
     os.environ["ROVERLAB_DAEMON"] = endpoint
     os.environ["ROVERLAB_LOG_DIR"] = str(tmp_path_factory.mktemp("log"))
-    ensure_daemon(endpoint)
     yield endpoint
     stop_daemon(endpoint)
-    if old is None:
-        os.environ.pop("ROVERLAB_DAEMON", None)
-    else:
-        os.environ["ROVERLAB_DAEMON"] = old
+    for key, value in old.items():
+        if value is None:
+            os.environ.pop(key, None)
+        else:
+            os.environ[key] = value
+
+
+@pytest.fixture(scope="session")
+def daemon(_private_daemon_endpoint: str) -> str:
+    """The session's daemon, started on its private port (see above)."""
+    from roverlab.core.transport.daemon import ensure_daemon
+
+    ensure_daemon(_private_daemon_endpoint)
+    return _private_daemon_endpoint
 
 
 @pytest.fixture

@@ -3,6 +3,7 @@ cv_bridge, visualization_msgs; a Python 2 script is one line naming file, line a
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -11,8 +12,10 @@ import numpy as np
 import pytest
 
 from roverlab.core import Context
+from roverlab.core.transport.zenoh import endpoint_reachable
 from roverlab.ros1 import run_script
 from roverlab.ros1.runner import python2_problem
+from tests.helpers.net import free_port
 
 SCRIPTS = (
     Path(__file__).resolve().parents[1] / "ros1_packages" / "book_robot_description" / "scripts"
@@ -62,14 +65,18 @@ def test_python2_script_is_one_line_with_the_fix() -> None:
         f"{SCRIPTS / 'py2_teleop.py'}:6: Python 2 code, a print statement: write print(...) "
         "(roverlab runs Python 3, as ROS noetic)"
     )
+    endpoint = f"tcp/127.0.0.1:{free_port()}"  # a daemon of its own, if it started one
     done = subprocess.run(
         [sys.executable, "-m", "roverlab.cli", "run", str(SCRIPTS / "py2_teleop.py")],
         capture_output=True,
         text=True,
         timeout=120,
+        env={**os.environ, "ROVERLAB_DAEMON": endpoint},
     )
     assert done.returncode == 1
     assert done.stderr.strip() == f"error: {line}"
+    # refused before joining the network: no daemon was started for it
+    assert not endpoint_reachable(endpoint)
 
 
 @pytest.mark.parametrize(

@@ -17,6 +17,7 @@ from roverlab.launch.registry import REGISTRY, LaunchState
 from roverlab.launch.xml import NodeSpec
 from roverlab.ros1 import run_script
 from roverlab.ros1.rospy.runtime import parse_command_line
+from roverlab.ros1.runner import python2_problem
 
 
 class RunError(RoverlabError):
@@ -96,6 +97,10 @@ def run(
     Options for roverlab go before the target; everything after it goes to the script.
     """
     script, spec, rest = _resolve(list(target) + list(ctx.args))
+    problem = None if script is None else python2_problem(script)
+    if problem is not None:  # refused before joining the network (or starting its daemon)
+        typer.echo(f"error: {problem}", err=True)
+        raise typer.Exit(1)
     transport, mode, note = connect_following_clock(network_options(ctx), clock)
     if note:
         typer.echo(f"note: {note}", err=True)
