@@ -52,6 +52,32 @@ def test_run_registry_node_serves_static_map(
         server.stop()
 
 
+def test_run_map_saver_exits_once_the_map_is_written(cli: Any, tmp_path: Path) -> None:
+    # `rosrun map_server map_saver -f NAME` exits 0 after "Done"; roverlab's run used to
+    # keep spinning after writing the map, until Ctrl-C
+    grid = np.zeros((10, 12), np.int8)
+    grid[2, :] = 100
+    saved = save_map(tmp_path / "room", grid, resolution=0.1, origin=(0.0, 0.0, 0.0))
+    server = Proc(
+        [
+            sys.executable,
+            "-m",
+            "roverlab.cli",
+            "run",
+            "map_server",
+            "map_server",
+            str(saved.yaml_path),
+        ]
+    )
+    try:
+        r = cli("run", "map_server", "map_saver", "-f", str(tmp_path / "copy"), timeout=60)
+        assert r.returncode == 0, r.stderr
+        assert "Done" in r.stderr
+        assert (tmp_path / "copy.pgm").read_bytes() == saved.image_path.read_bytes()
+    finally:
+        server.stop()
+
+
 def _hello_pkg(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
     """Package hello_pkg in ``tmp_path/ws`` (on ROVERLAB_PACKAGE_PATH): its folder."""
     pkg = tmp_path / "ws" / "hello_pkg"

@@ -119,6 +119,31 @@ def test_a_node_that_ends_is_respawned_or_ends_a_required_launch(tmp_path: Path)
         ctx.shutdown()
 
 
+def test_map_saver_finishes_cleanly_after_writing_the_map(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # roslaunch: map_saver exits 0 once the map is written ("process has finished
+    # cleanly"); it used to go on listening for ever
+    saved = save_map(tmp_path / "room", np.zeros((4, 5), np.int8), resolution=0.1)
+    path = _launch(tmp_path, "\n".join([
+        _map_server("map_server", "", str(saved.yaml_path)),
+        f'<node pkg="map_server" type="map_saver" name="saver" args="-f {tmp_path / "copy"}"/>',
+    ]))  # fmt: skip
+    ctx = Context(clock="wall")
+    try:
+        launch = build_launch(path, context=ctx)
+        launch.supervise(period_s=0.05)
+        deadline = time.monotonic() + 5.0
+        while "/saver" in launch.running:
+            assert time.monotonic() < deadline, launch.deaths
+            ctx.spin_for(0.05)
+        assert launch.deaths == []
+        assert "[INFO] process [/saver] has finished cleanly" in capsys.readouterr().err
+        assert (tmp_path / "copy.pgm").is_file()
+    finally:
+        ctx.shutdown()
+
+
 def test_output_log_keeps_info_off_the_screen_and_in_the_nodes_file(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:

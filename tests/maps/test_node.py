@@ -108,6 +108,8 @@ def test_map_saver_writes_files_after_one_map(tmp_path: Path) -> None:
     ]
     loaded = load_map(yaml_path).data
     assert loaded.tolist() == [[0, 100, -1, -1], [0, 100, 0, 0]]
+    # the node ends itself as map_saver's process exits (status 0)
+    assert saver.is_destroyed() and saver.exit_code == 0
     # later maps are ignored, as map_saver exits after the first
     mtime = image.stat().st_mtime_ns
     pub.publish(array_to_occupancy_grid(np.zeros((5, 5), np.int8), resolution=0.1))
@@ -141,6 +143,7 @@ def test_map_saver_reports_write_errors(tmp_path: Path) -> None:
     ctx.spin_for(0.1)
     assert saver.finished and not saver.done
     assert isinstance(saver.error, MapError) and "missing_dir" in str(saver.error)
+    assert saver.is_destroyed() and saver.exit_code == 1
     ctx.shutdown()
 
 

@@ -234,15 +234,19 @@ def run_context(
     context: Context,
     duration_s: float | None,
     before_shutdown: Callable[[], None] | None = None,
+    *,
+    until: Callable[[], bool] | None = None,
 ) -> float:
-    """Spin until ``duration_s`` of clock time (or forever), SIGINT / SIGTERM / SIGHUP, or
-    shutdown; then call ``before_shutdown`` (a launch stops its script processes while
-    its network still routes their last messages) and shut the context down (which
-    finishes recordings). Returns the wall seconds it ran."""
+    """Spin until ``duration_s`` of clock time (or forever), ``until()`` holds, SIGINT /
+    SIGTERM / SIGHUP, or shutdown; then call ``before_shutdown`` (a launch stops its script
+    processes while its network still routes their last messages) and shut the context
+    down (which finishes recordings). Returns the wall seconds it ran."""
     started = time.monotonic()
     try:
         with stop_on_signals(threading.Event(), context.executor.stop):
-            if duration_s is None:
+            if duration_s is None and until is not None:
+                context.spin_until_condition(until)
+            elif duration_s is None:
                 context.spin()
             else:
                 context.spin_for(duration_s)

@@ -132,4 +132,11 @@ def run(
                 err=True,
             )
             node.discard_parameter_overrides(unused)
-    run_context(context, None)
+    if node is None:
+        run_context(context, None)
+        return
+    # a node that ends itself (map_saver once the map is written) ends the run, as its
+    # ROS process exits
+    run_context(context, None, until=node.is_destroyed)
+    if node.exit_code:
+        raise typer.Exit(node.exit_code)

@@ -288,6 +288,9 @@ class Node:
         self.services: list[Service] = []
         self.clients: list[Client] = []
         self._destroyed = False
+        self.exit_code: int | None = None
+        """Set by a node that ends itself as a ROS 1 process exits (``map_saver`` once the
+        map is written: 0, or 1 when writing failed); None while it runs."""
         context._add_node(self)
         self.declare_parameter("use_sim_time", context.uses_sim_time)
 

@@ -239,8 +239,17 @@ class Launch:
         self._watch.start()
 
     def _ended(self, node_spec: NodeSpec) -> None:
-        if node_spec.fq_name in self.running and not self.context.is_shutdown():
-            self.died(node_spec, "it ended")
+        name = node_spec.fq_name
+        if name not in self.running or self.context.is_shutdown():
+            return
+        node = self.running[name][1]
+        if node.exit_code == 0 and not (node_spec.required or node_spec.respawn):
+            # its job done (map_saver wrote the map): roslaunch's clean exit
+            self.running.pop(name)
+            print(f"[INFO] process [{name}] has finished cleanly", file=sys.stderr, flush=True)
+            return
+        reason = "it ended" if node.exit_code is None else f"exit code {node.exit_code}"
+        self.died(node_spec, reason)
 
     def _exited(self, node_spec: NodeSpec, proc: ScriptProcess, code: int) -> None:
         name = node_spec.fq_name

@@ -84,7 +84,8 @@ class MapServer(Node):
 
 
 class MapSaver(Node):
-    """Saves the first map it receives, as ``map_saver -f NAME``.
+    """Saves the first map it receives, as ``map_saver -f NAME``, then ends itself (as
+    map_saver's process exits): ``exit_code`` 0 when saved, 1 when writing failed.
 
     Args:
         context: the context the node joins.
@@ -100,7 +101,7 @@ class MapSaver(Node):
     Attributes:
         done: a map was saved.
         saved_paths: ``(image, yaml)`` paths once saved.
-        error: why saving failed (the node then stops listening), or None.
+        error: why saving failed (the node has then ended too), or None.
 
     Raises:
         MapError: bad thresholds.
@@ -167,4 +168,6 @@ class MapSaver(Node):
             self.saved_paths = (saved.image_path, saved.yaml_path)
             self.done = True
             self._report("Done")
-        self.destroy_subscription(self._subscription)
+        # map_saver's process exits once it has written the map (or failed to)
+        self.exit_code = 0 if self.done else 1
+        self.destroy_node()
