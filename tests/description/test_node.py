@@ -124,6 +124,26 @@ def test_robot_description_is_latched_and_frame_prefix_applies() -> None:
     ctx.shutdown()
 
 
+def test_ros1_tf_prefix_prefixes_frames_and_an_empty_one_is_used_quietly() -> None:
+    # turtlebot3_remote.launch sets tf_prefix (empty unless multi-robot): it used to be
+    # reported as a parameter roverlab's robot_state_publisher does not use
+    ctx = Context()
+    model = load_robot(MYBOT_XACRO)
+    quiet = RobotStatePublisher(
+        ctx, robot_description=model, parameter_overrides={"tf_prefix": ""}, node_name="a"
+    )
+    assert quiet.unused_parameter_overrides() == [] and quiet.frame_prefix == ""
+    RobotStatePublisher(
+        ctx, robot_description=model, parameter_overrides={"tf_prefix": "/tb3_0"}, node_name="b"
+    )
+    buffer = listener(ctx)
+    ctx.spin_for(0.2)
+    assert lookup(buffer, "tb3_0/base_footprint", "tb3_0/base_laser_link").translation == (
+        pytest.approx((0.0, 0.0, 0.06))
+    )
+    ctx.shutdown()
+
+
 def _count_tf(ctx: Context) -> list[int]:
     counts = [0]
 

@@ -84,6 +84,8 @@ class RobotStatePublisher(Node):
         publish_frequency (double, 20.0): most publications per second of a joint (Hz).
         ignore_timestamp (bool, False): publish every joint state, stamped now.
         frame_prefix (string, ""): prepended to every frame id.
+        tf_prefix (string, ""): ROS 1's name: ``PREFIX/`` before every frame id (when
+            ``frame_prefix`` is empty).
 
     Raises:
         DescriptionError: no description, or an invalid one.
@@ -108,6 +110,11 @@ class RobotStatePublisher(Node):
         )
         self.ignore_timestamp = bool(self.declare_parameter("ignore_timestamp", False).value)
         self.frame_prefix = str(self.declare_parameter("frame_prefix", "").value)
+        # ROS 1's tf_prefix (turtlebot3_remote.launch sets it, empty unless multi-robot):
+        # tf::resolve puts "PREFIX/" before every frame
+        tf_prefix = str(self.declare_parameter("tf_prefix", "").value).strip("/")
+        if tf_prefix and not self.frame_prefix:
+            self.frame_prefix = tf_prefix + "/"
 
         self._description_pub = self.create_publisher(String, "robot_description", _LATCHED)
         self._description_pub.publish(String(data=self.model.urdf))
