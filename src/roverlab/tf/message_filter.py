@@ -164,8 +164,22 @@ class TfMessageFilter:
             except BackwardExtrapolationException:
                 return "too_old"
             except TransformException:
-                return "wait"
+                return "too_old" if self._never_transformable(target, frame, stamp) else "wait"
         return "ready"
+
+    def _never_transformable(self, target: str, frame: str, stamp: Time) -> bool:
+        """tf2's test (``addTransformableRequest``): the stamp is more than the cache time
+        behind the chain's latest common time, so its data is gone for good. A failed
+        lookup's exception does not say it: with ``odom`` as the target, a scan older
+        than the odometry kept can fail on the stale ``map -> odom`` edge above the target
+        (the error tf2 reports too) and look as if it should wait, for ever when the
+        process that publishes ``map -> odom`` (amcl) is the one waiting."""
+        buffer = self._buffer
+        try:
+            latest = buffer.get_latest_common_time(target, frame)
+        except TransformException:
+            return False
+        return bool(latest.nanoseconds) and stamp + buffer.cache_time < latest
 
     def _drop(self, msg: Any, reason: str) -> None:
         self.dropped += 1
