@@ -18,25 +18,19 @@ from tests.helpers.procs import Proc
 pytestmark = pytest.mark.zenoh
 
 
+def _map_server(yaml_path: Path, *args: str) -> Proc:
+    """``roverlab run map_server map_server YAML ARGS...`` in a process of its own."""
+    command = ["run", "map_server", "map_server", str(yaml_path), *args]
+    return Proc([sys.executable, "-m", "roverlab.cli", *command])
+
+
 def test_run_registry_node_serves_static_map(
     cli: Any, tmp_path: Path, capfd: pytest.CaptureFixture[str]
 ) -> None:
     grid = np.zeros((20, 30), np.int8)
     grid[5, :] = 100
     saved = save_map(tmp_path / "room", grid, resolution=0.1, origin=(-1.0, -1.0, 0.0))
-    server = Proc(
-        [
-            sys.executable,
-            "-m",
-            "roverlab.cli",
-            "run",
-            "map_server",
-            "map_server",
-            str(saved.yaml_path),
-            "__name:=my_map_server",
-            "_frame_id:=world",
-        ]
-    )
+    server = _map_server(saved.yaml_path, "__name:=my_map_server", "_frame_id:=world")
     try:
         r = cli("service", "call", "/static_map", "nav_msgs/GetMap", "--timeout", "15")
         assert r.returncode == 0, r.stderr
@@ -58,17 +52,7 @@ def test_run_map_saver_exits_once_the_map_is_written(cli: Any, tmp_path: Path) -
     grid = np.zeros((10, 12), np.int8)
     grid[2, :] = 100
     saved = save_map(tmp_path / "room", grid, resolution=0.1, origin=(0.0, 0.0, 0.0))
-    server = Proc(
-        [
-            sys.executable,
-            "-m",
-            "roverlab.cli",
-            "run",
-            "map_server",
-            "map_server",
-            str(saved.yaml_path),
-        ]
-    )
+    server = _map_server(saved.yaml_path)
     try:
         r = cli("run", "map_server", "map_saver", "-f", str(tmp_path / "copy"), timeout=60)
         assert r.returncode == 0, r.stderr
