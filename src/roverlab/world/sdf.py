@@ -29,7 +29,8 @@ collision. Robots (models with sensors or plugins), actors, heightmaps, models n
 and other unknown elements are skipped and reported in :attr:`World.warnings` (a missing
 ``model://NAME`` as ``model NAME skipped: model://X not found``, which
 :func:`roverlab.world.group_warnings` groups); lights, physics,
-GUI and the like are ignored silently. Robots spawn at the origin, as in Gazebo.
+GUI and the like are ignored silently, except that Gazebo's ``<physics>`` timing and
+world plugins are named in :attr:`World.notes`. Robots spawn at the origin, as in Gazebo.
 
 Includes are looked up (first match wins) in: the caller's ``model_path``,
 ``$ROVERLAB_MODEL_PATH``, ``$GAZEBO_MODEL_PATH``, the world file's folder and its
@@ -48,6 +49,7 @@ from pathlib import Path
 
 from roverlab.geometry import SE2, Transform3
 from roverlab.world._materials import ScriptMaterial
+from roverlab.world._notes import movable_note, world_notes
 from roverlab.world._xml import XmlDoc, parse_xml_file
 from roverlab.world.errors import WorldError
 from roverlab.world.model import (
@@ -111,16 +113,6 @@ def _package_model_paths(world_dir: Path) -> list[Path]:
                             out.append(Path(path))
         return out
     return []
-
-
-def _movable_note(path: Path, names: list[str]) -> tuple[str, ...]:
-    if not names:
-        return ()
-    shown = ", ".join(names[:8]) + (f" and {len(names) - 8} more" if len(names) > 8 else "")
-    return (
-        f"{path}: {len(names)} model{'s' if len(names) != 1 else ''} not <static> (Gazebo "
-        f"lets a robot push them) kept as fixed obstacles: {shown}",
-    )
 
 
 def model_search_path(
@@ -228,7 +220,7 @@ class _SdfLoader(SdfShapeReader):
             sky_rgb=sky,
             source=path,
             warnings=tuple(self.warnings),
-            notes=_movable_note(path, self.movable),
+            notes=movable_note(path, self.movable) + world_notes(path, worlds[:1]),
         )
 
     def _warn(self, doc: XmlDoc, el: ET.Element, msg: str) -> None:
