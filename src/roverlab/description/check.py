@@ -19,7 +19,7 @@ import math
 from typing import Final
 
 from roverlab.description.errors import DescriptionError
-from roverlab.description.gazebo import REFERENCE_KEYS
+from roverlab.description.gazebo import DISTORTION_KEYS, REFERENCE_KEYS
 from roverlab.description.gazebo_specs import (
     CameraPluginSpec,
     DiffDriveSpec,
@@ -154,7 +154,7 @@ def _physics_notes(model: RobotModel, detail: bool) -> list[str]:
 
 
 # names tutorials give camera plugins that GazeboRosCameraUtils reads under other names
-_CAMERA_MISNAMED: Final = ("baseline", *(f"distortion_{k}" for k in ("k1", "k2", "k3", "t1", "t2")))
+_CAMERA_MISNAMED: Final = ("baseline", *(f"distortion_{k}" for k in DISTORTION_KEYS))
 
 
 def _camera_notes(model: RobotModel) -> list[str]:

@@ -54,7 +54,7 @@ from roverlab.description.gazebo_specs import (
 from roverlab.description.gazebo_values import ElementValues, flatten_element
 from roverlab.geometry import Transform3, quat_from_rpy
 
-__all__ = ["PLUGIN_SPECS", "REFERENCE_KEYS", "parse_gazebo"]
+__all__ = ["DISTORTION_KEYS", "PLUGIN_SPECS", "REFERENCE_KEYS", "parse_gazebo"]
 
 
 # --------------------------------------------------------------------------- parsing
@@ -249,14 +249,15 @@ def _laser(v: ElementValues, plugin: GazeboPlugin) -> LaserPluginSpec:
     )
 
 
-_DISTORTION: Final = ("k1", "k2", "k3", "t1", "t2")
+# GazeboRosCameraUtils' distortion coefficients: distortionK1 .. distortionT2
+DISTORTION_KEYS: Final = ("k1", "k2", "k3", "t1", "t2")
 
 
 def _distortions(v: ElementValues) -> dict[str, float]:
     """The five ``distortion_*`` fields of a camera plugin spec, from ``distortionK1``..
     ``distortionT2`` (GazeboRosCameraUtils reads only these names: a ``distortion_k1``
     seen in tutorials is ignored, and ``urdf check`` notes it)."""
-    return {f"distortion_{k}": v.number("distortion" + k.upper(), 0.0) for k in _DISTORTION}
+    return {f"distortion_{k}": v.number("distortion" + k.upper(), 0.0) for k in DISTORTION_KEYS}
 
 
 def _camera_plugin(v: ElementValues, plugin: GazeboPlugin) -> CameraPluginSpec:

@@ -39,7 +39,6 @@ __all__ = [
     "ScriptProcesses",
     "child_network",
     "find_script",
-    "find_scripts",
     "is_python_script",
     "launch_endpoint",
     "ros_home",
@@ -63,22 +62,16 @@ class ScriptLookupError(Exception):
         self.missing = missing
 
 
-def find_scripts(pkg: str, type_: str, package_path: tuple[str, ...] = ()) -> list[Path]:
-    """The files named ``type_`` in package ``pkg``, searched through the package's
-    folders as roslaunch and rosrun find a node's executable (``roverlab launch``'s script
-    nodes and ``roverlab run PKG TYPE`` both look here): one to run; none, or several
-    (roslaunch's "multiple files named"), to report. A ``type_`` with a ``/`` is a path
-    inside the package (``scripts/talker.py``, as rosrun takes it): that one file. The
-    executable bit is not required: the callers note a file without it.
+def _files_named(folder: Path, pkg: str, type_: str) -> list[Path]:
+    """The files named ``type_`` in package ``pkg`` (at ``folder``), searched through the
+    package's folders as roslaunch and rosrun find a node's executable: one to run; none,
+    or several (roslaunch's "multiple files named"), to report. A ``type_`` with a ``/``
+    is a path inside the package (``scripts/talker.py``, as rosrun takes it): that one
+    file. The executable bit is not required: the callers note a file without it.
 
     Raises:
-        PackageNotFoundError: no such package (with the folders searched).
         ScriptLookupError: a path that leaves the package (``..``, absolute).
     """
-    return _files_named(find_package(pkg, package_path), pkg, type_)
-
-
-def _files_named(folder: Path, pkg: str, type_: str) -> list[Path]:
     if not type_:
         return []
     if "/" in type_:
@@ -91,9 +84,10 @@ def _files_named(folder: Path, pkg: str, type_: str) -> list[Path]:
 
 
 def find_script(pkg: str, type_: str, package_path: tuple[str, ...] = ()) -> Path:
-    """The one Python script that ``rosrun pkg type`` or ``<node pkg type>`` runs (found as
-    :func:`find_scripts` finds it): the decision ``roverlab run``, the launch's runner and
-    ``roverlab launch`` (which exposes the topics of the script nodes) share.
+    """The one Python script that ``rosrun pkg type`` or ``<node pkg type>`` runs, searched
+    through the package's folders as roslaunch does: the decision ``roverlab run``, the
+    launch's runner and ``roverlab launch`` (which exposes the topics of the script nodes)
+    share.
 
     Raises:
         ScriptLookupError: no such package or file (``missing``), a path outside the

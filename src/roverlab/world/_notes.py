@@ -20,14 +20,14 @@ def movable_note(path: Path, names: list[str]) -> tuple[str, ...]:
     )
 
 
-def world_notes(path: Path, worlds: list[ET.Element]) -> tuple[str, ...]:
+def world_notes(path: Path, world: ET.Element | None) -> tuple[str, ...]:
     """The world's settings of Gazebo's own that the simulator does not act on: its
     ``<physics>`` step and rate when they differ from Gazebo's defaults (roverlab steps at
-    the ``physics_rate`` parameter and runs at ``--rate``), and its world plugins."""
-    if not worlds:
+    the ``physics_rate`` parameter and runs at ``--rate``), and its world plugins (none
+    for a file that holds models only)."""
+    if world is None:
         return ()
     out: list[str] = []
-    world = worlds[0]
     physics = [
         f"{el.tag} {(el.text or '').strip()}"
         for ph in world.findall("physics")

@@ -220,7 +220,8 @@ class _SdfLoader(SdfShapeReader):
             sky_rgb=sky,
             source=path,
             warnings=tuple(self.warnings),
-            notes=movable_note(path, self.movable) + world_notes(path, worlds[:1]),
+            notes=movable_note(path, self.movable)
+            + world_notes(path, worlds[0] if worlds else None),
         )
 
     def _warn(self, doc: XmlDoc, el: ET.Element, msg: str) -> None:
