@@ -29,13 +29,9 @@ if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
 @pytest.fixture(scope="session", autouse=True)
 def _mesh_cache(tmp_path_factory: pytest.TempPathFactory) -> Iterator[None]:
     """Processed meshes go to a per-session folder, not the user's ~/.cache."""
-    old = os.environ.get("ROVERLAB_CACHE_DIR")
-    os.environ["ROVERLAB_CACHE_DIR"] = str(tmp_path_factory.mktemp("cache"))
-    yield
-    if old is None:
-        os.environ.pop("ROVERLAB_CACHE_DIR", None)
-    else:
-        os.environ["ROVERLAB_CACHE_DIR"] = old
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("ROVERLAB_CACHE_DIR", str(tmp_path_factory.mktemp("cache")))
+        yield
 
 
 @pytest.fixture(scope="session", autouse=True)
@@ -46,16 +42,11 @@ def _private_daemon_endpoint(tmp_path_factory: pytest.TempPathFactory) -> Iterat
     from roverlab.core.transport.daemon import stop_daemon
 
     endpoint = f"tcp/127.0.0.1:{free_port()}"
-    old = {k: os.environ.get(k) for k in ("ROVERLAB_DAEMON", "ROVERLAB_LOG_DIR")}
-    os.environ["ROVERLAB_DAEMON"] = endpoint
-    os.environ["ROVERLAB_LOG_DIR"] = str(tmp_path_factory.mktemp("log"))
-    yield endpoint
-    stop_daemon(endpoint)
-    for key, value in old.items():
-        if value is None:
-            os.environ.pop(key, None)
-        else:
-            os.environ[key] = value
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("ROVERLAB_DAEMON", endpoint)
+        mp.setenv("ROVERLAB_LOG_DIR", str(tmp_path_factory.mktemp("log")))
+        yield endpoint
+        stop_daemon(endpoint)
 
 
 @pytest.fixture(scope="session")
