@@ -295,7 +295,12 @@ def test_frame_rate_of_the_rviz_file_caps_the_draws(rated: DashboardServer, brow
     page.locator("#frame-rate").dispatch_event("change")
     page.wait_for_function("() => viz.redraw.frameRate === 10")
     assert wait_until(lambda: rated.bridge.config.frame_rate_hz == 10.0, 5.0)
-    rate = page.evaluate(_RATE_JS, "3d")
-    assert 6.0 <= rate <= 12.5, f"3D: {rate:.1f} frames a second with Frame Rate 10"
+    # the new cap, read where drawing is cheap: software WebGL on a loaded machine may not
+    # reach 10 frames a second in 3D (5.999 was seen), which would measure the machine
+    # rather than the cap (one scheduler caps both views)
+    page.evaluate("() => viz.setViewMode('2D')")
+    page.wait_for_function("() => viz.data.frames > 2")
+    rate = page.evaluate(_RATE_JS, "2d")
+    assert 6.0 <= rate <= 12.5, f"2D: {rate:.1f} frames a second with Frame Rate 10"
     assert not errors, f"JavaScript errors on the page: {errors}"
     page.close()
