@@ -13,10 +13,12 @@ from roverlab.autonomy.story import DemoStory
 from roverlab.bag import McapRecorder
 from roverlab.cli.common import StartGuard, expose_if_asked, stop_on_signals
 from roverlab.cli.sim import parse_rate
+from roverlab.cli.viz import PortOption
 from roverlab.core import Context, configure_logging
 from roverlab.description import find_package
 from roverlab.errors import RoverlabError
 from roverlab.viz.config import DisplayConfig, load_rviz
+from roverlab.viz.ports import choose_port, start_page
 from roverlab.viz.server import DashboardServer
 
 
@@ -43,7 +45,7 @@ def demo(
             "report until Ctrl-C; --no-dashboard runs headless and exits after the report.",
         ),
     ] = True,
-    port: Annotated[int, typer.Option("--port", help="Dashboard port (127.0.0.1).")] = 8080,
+    port: PortOption = None,
     expose: Annotated[
         bool | None,
         typer.Option(
@@ -79,8 +81,9 @@ def demo(
             config.displays.append(  # explore_lite's frontiers while it explores
                 DisplayConfig(kind="marker_array", name="Frontiers", topic="/explore/frontiers")
             )
-            server = DashboardServer(context, "127.0.0.1", port, config=config, map_dir=out)
-            server.start()
+            choice = choose_port(port)
+            server = DashboardServer(context, "127.0.0.1", choice.port, config=config, map_dir=out)
+            start_page(server, choice, say=typer.echo)
             typer.echo(f"dashboard: {server.url}  (open it in a browser)")
         expose_if_asked(ctx, context, expose, pace)
         story = DemoStory(context, out, places=places, seed=seed, log=typer.echo)

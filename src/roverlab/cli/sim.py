@@ -101,8 +101,14 @@ def sim(
         typer.Option("--dashboard", help="Serve the web dashboard (rviz) from this process."),
     ] = False,
     dashboard_port: Annotated[
-        int, typer.Option("--dashboard-port", help="Port of the --dashboard (127.0.0.1).")
-    ] = 8080,
+        int | None,
+        typer.Option(
+            "--dashboard-port",
+            help="Port of the --dashboard (127.0.0.1; 0: any free one). Default: "
+            "$ROVERLAB_DASHBOARD_PORT, else 8080, or the next free port when it is taken.",
+            show_default=False,
+        ),
+    ] = None,
     strict: Annotated[
         bool,
         typer.Option(
@@ -155,7 +161,7 @@ def _run(
     pace: float,
     rate: str,
     dashboard: bool,
-    dashboard_port: int,
+    dashboard_port: int | None,
     duration: float | None,
     strict: bool,
 ) -> None:
@@ -189,11 +195,13 @@ def _run(
         err=True,
     )
     if dashboard:  # the context's shutdown (end of run_context) stops it
+        from roverlab.viz.ports import choose_port, start_page
         from roverlab.viz.server import DashboardServer  # FastAPI: only with --dashboard
 
         try:
-            server = DashboardServer(context, "127.0.0.1", dashboard_port)
-            server.start()
+            choice = choose_port(dashboard_port, option_name="--dashboard-port")
+            server = DashboardServer(context, "127.0.0.1", choice.port)
+            start_page(server, choice, say=lambda text: typer.echo(text, err=True))
         except BaseException:
             context.shutdown()
             raise

@@ -15,12 +15,21 @@ from roverlab.cli.common import Connection, HostOption, network_options
 from roverlab.viz.config import DashboardConfig, default_config, load_config
 from roverlab.viz.errors import DashboardError
 from roverlab.viz.launcher import image_view_config
+from roverlab.viz.ports import choose_port, start_page
 from roverlab.viz.server import DashboardServer
 
-__all__ = ["dashboard", "image_app", "image_view", "load_dashboard_config"]
+__all__ = ["PortOption", "dashboard", "image_app", "image_view", "load_dashboard_config"]
 
-# the options of both pages (dashboard, image_view) besides --host
-PortOption = Annotated[int, typer.Option("--port", help="TCP port to serve on.")]
+# the options of the pages (dashboard, image view; demo's --port too) besides --host
+PortOption = Annotated[
+    int | None,
+    typer.Option(
+        "--port",
+        help="TCP port to serve on (0: any free one). Default: $ROVERLAB_DASHBOARD_PORT, "
+        "else 8080, or the next free port after 8080 when it is taken.",
+        show_default=False,
+    ),
+]
 TokenOption = Annotated[
     str | None, typer.Option("--token", help="Access token (made up for non-loopback).")
 ]
@@ -47,7 +56,7 @@ def load_dashboard_config(path: Path | None, fixed_frame: str | None) -> Dashboa
 def dashboard(
     ctx: typer.Context,
     host: HostOption = "127.0.0.1",
-    port: PortOption = 8080,
+    port: PortOption = None,
     rviz: Annotated[
         Path | None,
         typer.Option(
@@ -81,17 +90,18 @@ def dashboard(
 def _serve(
     ctx: typer.Context,
     host: str,
-    port: int,
+    port: int | None,
     token: str | None,
     config: DashboardConfig | None,
     save_config: Path | None,
     map_dir: Path,
 ) -> None:
+    choice = choose_port(port)
     with Connection(network_options(ctx)) as conn:
         server = DashboardServer(
             conn.context,
             host,
-            port,
+            choice.port,
             token,
             config=config,
             config_path=save_config,
@@ -99,7 +109,7 @@ def _serve(
             remote_graph=conn.graph,
         )
         conn.context.spin_in_thread()
-        server.start()
+        start_page(server, choice, say=typer.echo)
         typer.echo(f"dashboard: {server.url}")
         try:
             while True:
@@ -120,7 +130,7 @@ def image_view(
         ),
     ] = None,
     host: HostOption = "127.0.0.1",
-    port: PortOption = 8080,
+    port: PortOption = None,
     token: TokenOption = None,
 ) -> None:
     """rqt_image_view: the dashboard with its image panel on TOPIC."""

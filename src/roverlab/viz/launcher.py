@@ -3,9 +3,10 @@
 The launch registry maps ``("rviz", "rviz")`` to :func:`start_rviz`. rviz's own command
 line is honoured: ``-d`` / ``--display-config FILE`` (an ``.rviz`` or a saved dashboard
 ``.json``) and ``-f`` / ``--fixed-frame FRAME``; other rviz options are reported and
-ignored. The web server binds ``$ROVERLAB_DASHBOARD_HOST`` (default ``127.0.0.1``) and
-``$ROVERLAB_DASHBOARD_PORT`` (default ``8080``; ``0`` picks a free port); it stops when the
-launch's context shuts down.
+ignored. The web server binds ``$ROVERLAB_DASHBOARD_HOST`` (default ``127.0.0.1``) and the
+port of :func:`~roverlab.viz.ports.choose_port` (``$ROVERLAB_DASHBOARD_PORT``, else 8080 or
+the next free port after it; ``0`` picks a free port); it stops when the launch's context
+shuts down.
 """
 
 from __future__ import annotations
@@ -25,9 +26,9 @@ from roverlab.viz.config import (
     load_config,
 )
 from roverlab.viz.errors import DashboardError
+from roverlab.viz.ports import PortChoice, choose_port, start_page
 
 __all__ = [
-    "DEFAULT_PORT",
     "RvizArgs",
     "image_view_config",
     "parse_rviz_args",
@@ -35,7 +36,6 @@ __all__ = [
     "start_rviz",
 ]
 
-DEFAULT_PORT: Final = 8080
 _FLAGS_WITH_VALUE: Final = ("-l", "--log-config", "-s", "--splash-screen", "--opengl")
 
 
@@ -90,8 +90,9 @@ def start_rviz(
     """Start the dashboard on ``context`` for an rviz ``<node>``; returns its node.
 
     A missing or bad display config is reported through ``warn`` and the default
-    displays are used (rviz starts with its defaults too); a port that is taken is
-    reported and the dashboard is not started (None).
+    displays are used (rviz starts with its defaults too); a ``$ROVERLAB_DASHBOARD_PORT``
+    that is taken is reported and the dashboard is not started (None); the default port,
+    when taken, gives way to the next free one (reported).
 
     Raises:
         DashboardError: malformed ``args`` or a bad ``$ROVERLAB_DASHBOARD_PORT``.
@@ -112,10 +113,10 @@ def start_rviz(
         config.fixed_frame = parsed.fixed_frame
     from roverlab.viz.server import DashboardServer  # FastAPI: only when a node asks for it
 
-    host, port = _dashboard_address()
-    server = DashboardServer(context, host, port, config=config, node_name=node_name)
+    host, choice = _dashboard_address()
+    server = DashboardServer(context, host, choice.port, config=config, node_name=node_name)
     try:
-        server.start()
+        start_page(server, choice, say=lambda text: warn(f"{where}rviz: {text}"))
     except DashboardError as err:
         warn(f"{where}rviz/rviz not started: {err}")
         server.bridge.node.destroy_node()
@@ -124,21 +125,13 @@ def start_rviz(
     return server.bridge.node
 
 
-def _dashboard_address() -> tuple[str, int]:
-    """``$ROVERLAB_DASHBOARD_HOST`` (default 127.0.0.1) and ``$ROVERLAB_DASHBOARD_PORT``.
+def _dashboard_address() -> tuple[str, PortChoice]:
+    """``$ROVERLAB_DASHBOARD_HOST`` (default 127.0.0.1) and the port rule's port.
 
     Raises:
         DashboardError: the port is not a number.
     """
-    host = os.environ.get("ROVERLAB_DASHBOARD_HOST", "127.0.0.1")
-    text = os.environ.get("ROVERLAB_DASHBOARD_PORT", str(DEFAULT_PORT))
-    try:
-        port = int(text)
-    except ValueError:
-        raise DashboardError(
-            f"ROVERLAB_DASHBOARD_PORT must be a port number, got {text!r}"
-        ) from None
-    return host, port
+    return os.environ.get("ROVERLAB_DASHBOARD_HOST", "127.0.0.1"), choose_port(None)
 
 
 def image_view_config(topic: str | None) -> DashboardConfig:
@@ -177,21 +170,17 @@ def start_image_view(
     topic = positional[0] if positional else remaps.get("image") or remaps.get("/image")
     from roverlab.viz.server import DashboardServer  # FastAPI: only when a node asks for it
 
-    host, port = _dashboard_address()
-    for attempt in (port, 0):
-        server = DashboardServer(
-            context, host, attempt, config=image_view_config(topic), node_name=node_name
-        )
-        try:
-            server.start()
-        except DashboardError as err:
-            server.bridge.node.destroy_node()
-            if attempt == 0:
-                warn(f"{where}rqt_image_view not started: {err}")
-                return None
-            continue
-        server.bridge.node.get_logger().info(
-            f"rqt_image_view: the image panel is at {server.url}" + (f" ({topic})" if topic else "")
-        )
-        return server.bridge.node
-    return None
+    host, choice = _dashboard_address()
+    server = DashboardServer(
+        context, host, choice.port, config=image_view_config(topic), node_name=node_name
+    )
+    try:
+        server.start(next_free=True)  # beside an rviz of the same launch on that port
+    except DashboardError as err:
+        server.bridge.node.destroy_node()
+        warn(f"{where}rqt_image_view not started: {err}")
+        return None
+    server.bridge.node.get_logger().info(
+        f"rqt_image_view: the image panel is at {server.url}" + (f" ({topic})" if topic else "")
+    )
+    return server.bridge.node

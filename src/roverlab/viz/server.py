@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import errno
 import hmac
 import ipaddress
 import json
@@ -58,6 +59,7 @@ from roverlab.errors import RoverlabError
 from roverlab.viz.bridge import DisplayState, VizBridge
 from roverlab.viz.config import DashboardConfig, config_from_dict, save_config
 from roverlab.viz.errors import DashboardError
+from roverlab.viz.ports import NEXT_FREE_TRIES, PortTakenError
 
 __all__ = ["DashboardServer", "is_loopback"]
 
@@ -361,15 +363,20 @@ class DashboardServer:
         query = f"/?token={self.token}" if self.token else "/"
         return f"http://{host}:{self.port}{query}"
 
-    def start(self) -> None:
+    def start(self, *, next_free: bool = False) -> None:
         """Serve in a daemon thread; returns once the socket listens.
 
+        Args:
+            next_free: when :attr:`port` is taken, serve on the next free port after it
+                (see :attr:`port` afterwards) instead of failing.
+
         Raises:
-            DashboardError: the server did not come up (port in use, bad host).
+            PortTakenError: the port is in use (and ``next_free`` is not set).
+            DashboardError: the server did not come up (bad host).
         """
         if self._thread is not None:
             raise DashboardError("dashboard already started")
-        sock = self._listen()
+        sock = self._listen(next_free)
         self.port = int(sock.getsockname()[1])
         config = uvicorn.Config(self.app, log_level="warning", ws="websockets-sansio")
         server = uvicorn.Server(config)
@@ -392,9 +399,22 @@ class DashboardServer:
         if self.generated_token:
             print(f"dashboard token (required by every client): {self.token}", file=sys.stderr)
 
-    def _listen(self) -> socket.socket:
+    def _listen(self, next_free: bool) -> socket.socket:
+        candidates = [self.port]
+        if next_free and self.port:
+            top = min(65535, self.port + NEXT_FREE_TRIES)
+            candidates += [*range(self.port + 1, top + 1), 0]
+        for port in candidates:
+            try:
+                return self._bind(port)
+            except PortTakenError:
+                if port == candidates[-1]:
+                    raise
+        raise AssertionError("unreachable")  # pragma: no cover
+
+    def _bind(self, port: int) -> socket.socket:
         try:
-            infos = socket.getaddrinfo(self.host, self.port, type=socket.SOCK_STREAM)
+            infos = socket.getaddrinfo(self.host, port, type=socket.SOCK_STREAM)
         except OSError as err:
             raise DashboardError(f"dashboard: bad host {self.host!r}: {err}") from err
         family, _, _, _, address = infos[0]
@@ -405,9 +425,10 @@ class DashboardServer:
             sock.listen(128)
         except OSError as err:
             sock.close()
-            raise DashboardError(
-                f"dashboard cannot listen on {self.host}:{self.port}: {err.strerror or err}"
-            ) from err
+            text = f"dashboard cannot listen on {self.host}:{port}: {err.strerror or err}"
+            if err.errno == errno.EADDRINUSE:
+                raise PortTakenError(text, port) from err
+            raise DashboardError(text) from err
         sock.setblocking(False)
         return sock
 
