@@ -6,6 +6,7 @@ from __future__ import annotations
 import io
 import json
 import struct
+import time
 from pathlib import Path
 
 import numpy as np
@@ -28,6 +29,7 @@ from roverlab.viz.bridge import VizBridge
 from roverlab.viz.config import DashboardConfig, DisplayConfig
 from roverlab.viz.errors import DashboardError
 from roverlab.viz.protocol import KIND_MAP, KIND_MAP_PATCH, KIND_POSES, POSES_3D
+from roverlab.viz.status import RateMeter
 
 LATCHED = QoSProfile(depth=1, durability="transient_local")
 
@@ -100,6 +102,8 @@ def test_statuses_no_publisher_no_messages_tf_failure_and_ok() -> None:
             DisplayConfig("pose_array", "off", False, "/good"),
         ),
     )
+    assert _rows(bridge, 2)["Topic"] == ("ok", "Subscribed to /quiet; waiting for messages")
+    bridge.quiet_after_s = 0.0  # as if 5 s had passed
     ctx.spin_for(0.1)
     good.publish(make("geometry_msgs/msg/PoseArray", header={"frame_id": "odom"},
                       poses=[pose_from_xytheta(1.0, 2.0, 0.0)]))  # fmt: skip
@@ -114,7 +118,9 @@ def test_statuses_no_publisher_no_messages_tf_failure_and_ok() -> None:
     assert np.allclose(pose, [2.0, 2.0, 0.0, 0.0, 0.0, 0.0, 1.0])  # odom is 1 m along map's x
     level, text = _rows(bridge, 1)["Transform"]
     assert level == "error" and "ghost" in text
-    assert _rows(bridge, 2)["Topic"] == ("warn", "No messages received on /quiet")
+    level, text = _rows(bridge, 2)["Topic"]
+    assert level == "warn" and text.startswith("No messages received on /quiet for ")
+    assert text.endswith(" s (1 publisher(s) sent nothing)")
     assert _rows(bridge, 3)["Topic"] == ("warn", "No publisher on /nobody")
     assert _rows(bridge, 4)["Topic"][0] == "error"  # /good carries PoseArray, not Odometry
     assert _rows(bridge, 5) == {"Status": ("disabled", "disabled")}
@@ -275,3 +281,42 @@ def test_intensity_transformer_colours_scans_and_clouds() -> None:
     assert abs(got[1][0] - 128) <= 3 and abs(got[1][2] - 128) <= 3  # half way
     assert _rows(bridge, 2)["Color Transformer"][0] == "warn"  # no 'heat' channel: flat
     ctx.shutdown()
+
+
+def test_a_display_receiving_messages_is_ok_whatever_the_graph_says() -> None:
+    """rviz's rule: messages arriving is OK, even when the graph shows no publisher (another
+    process's publisher not known yet: the old status said "No publisher on /scan (76
+    messages received)"); a stream that stops warns and names the cause."""
+    ctx = Context()
+    bridge = VizBridge(
+        context=ctx,
+        config=_config(
+            DisplayConfig("laser_scan", "scan", True, "/scan"),
+            DisplayConfig("path", "plan", True, "/plan"),
+        ),
+    )
+    scan, plan = bridge.displays
+    for d in (scan, plan):
+        d.received, d.last_message_s = 76, time.monotonic()
+    assert _rows(bridge, 0)["Topic"] == ("ok", "76 messages received")
+    # the stream stops: the scan warns, the plan (published once) stays OK
+    for d in (scan, plan):
+        d.last_message_s = time.monotonic() - 6.0
+    level, text = _rows(bridge, 0)["Topic"]
+    assert level == "warn"
+    assert text == "No messages on /scan for 6 s (no publisher; 76 messages received before)"
+    assert _rows(bridge, 1)["Topic"] == ("ok", "76 messages received")
+    ctx.shutdown()
+
+
+def test_rate_meter_sums_sources_and_survives_restarts() -> None:
+    meter = RateMeter(window_s=3.0)
+    for i in range(5):  # one process at 10 Hz, another at 5 Hz on the same topic
+        meter.observe("a", float(i), {"/scan": 100 + 10 * i})
+        meter.observe("b", float(i) + 0.5, {"/scan": 5 * i, "/odom": 1000 + 20 * i})
+    rates = meter.rates(4.5)
+    assert rates == pytest.approx({"/scan": 15.0, "/odom": 20.0})
+    meter.observe("a", 5.0, {"/scan": 3})  # "a" restarted: its samples start again
+    meter.observe("a", 6.0, {"/scan": 13})
+    assert meter.rates(6.0)["/scan"] == pytest.approx(15.0)
+    assert meter.rates(30.0) == {}  # sources not heard from are forgotten

@@ -202,6 +202,7 @@ def live(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Live]:
     server = DashboardServer(
         ctx, "127.0.0.1", 0, config=config, map_dir=map_dir, config_path=map_dir / "dash.json"
     )
+    server.bridge.quiet_after_s = 2.0  # a silent topic warns after 2 s (5 s by default)
     ctx.spin_in_thread()
     server.start()
     yield Live(
@@ -327,6 +328,12 @@ def test_path_poses_cloud_and_markers_are_drawn(live: Live, page: Any, tmp_path:
 def test_status_tree_reports_silent_topics_and_tf_failures(page: Any) -> None:
     page.wait_for_function(
         "() => document.querySelector('.display[data-slot] .status') !== null", timeout=5000
+    )
+    page.wait_for_function(  # the silent topic's grace time is over
+        "() => Array.from(document.querySelectorAll('#displays .display')).some(e =>"
+        " e.querySelector('.dname').textContent.startsWith('Silent')"
+        " && e.dataset.status === 'warn')",
+        timeout=10000,
     )
     rows = page.evaluate(
         "() => Array.from(document.querySelectorAll('#displays .display')).map(e =>"

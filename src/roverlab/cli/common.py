@@ -24,6 +24,7 @@ from roverlab.core.transport.zenoh import (
     ZenohTransport,
     query_graph,
 )
+from roverlab.core.transport.zenoh_stats import query_topic_counts
 from roverlab.errors import RoverlabError
 
 __all__ = [
@@ -162,6 +163,12 @@ class Connection:
             if ents or time.monotonic() >= self._fresh_until:
                 return ents
             time.sleep(0.1)
+
+    def topic_counts(self, timeout_s: float = 1.0) -> dict[str, dict[str, int]]:
+        """Messages published per topic by each other process: ``{zid: {topic: n}}``."""
+        counts = query_topic_counts(self.transport.session, self.transport.domain, timeout_s)
+        counts.pop(self.transport.zid, None)
+        return counts
 
     def close(self) -> None:
         self.context.shutdown()

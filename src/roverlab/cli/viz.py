@@ -107,6 +107,7 @@ def _serve(
             config_path=save_config,
             map_dir=map_dir,
             remote_graph=conn.graph,
+            remote_counts=conn.topic_counts,
         )
         conn.context.spin_in_thread()
         start_page(server, choice, say=typer.echo)

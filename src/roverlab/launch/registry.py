@@ -6,9 +6,11 @@ Plugins from other packages register through the ``roverlab.nodes`` entry-point 
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import shlex
 from collections.abc import Callable
+from functools import partial
 from importlib.metadata import entry_points
 from pathlib import Path
 from typing import Any
@@ -18,10 +20,17 @@ from roverlab.description import load_robot
 from roverlab.description.node import JointStatePublisher, RobotStatePublisher
 from roverlab.geometry import quat_from_rpy
 from roverlab.launch.devices import DEVICE_NODES
-from roverlab.launch.state import LaunchState, NodeFactory, node_factory, node_kwargs
+from roverlab.launch.state import (
+    LaunchState,
+    NodeFactory,
+    build_node,
+    node_factory,
+    node_kwargs,
+)
 from roverlab.launch.xml import LaunchError, NodeSpec
 from roverlab.maps.node import MapSaver, MapServer
 from roverlab.msgs import classes as mc
+from roverlab.perception.image_transport.node import Republish
 from roverlab.viz.errors import DashboardError
 from roverlab.viz.joints import SLIDER_TOPIC
 from roverlab.viz.launcher import start_image_view, start_rviz
@@ -294,6 +303,21 @@ _NODES = {
 }
 for _key, _path in _NODES.items():
     REGISTRY[_key] = node_factory(_path)
+
+
+@register("image_transport", "republish")
+def _republish(state: LaunchState, spec: NodeSpec) -> Node:
+    """``republish IN_TRANSPORT [in:=IN] [OUT_TRANSPORT] [out:=OUT]`` (``in``/``out`` also
+    as ``<remap>``)."""
+    argv = shlex.split(spec.args)
+    transports = [a for a in argv if ":=" not in a]
+    if not 1 <= len(transports) <= 2:
+        raise LaunchError(f"{spec.source}: republish takes IN_TRANSPORT [OUT_TRANSPORT]")
+    remaps = dict(a.split(":=", 1) for a in argv if ":=" in a)
+    spec = dataclasses.replace(spec, remaps={**spec.remaps, **remaps})
+    out = transports[1] if len(transports) > 1 else None
+    make = partial(Republish, in_transport=transports[0], out_transport=out)
+    return build_node(state, spec, make)
 
 
 def _unavailable(reason: str) -> NodeFactory:

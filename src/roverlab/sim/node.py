@@ -21,6 +21,7 @@ from roverlab.geometry import Transform3, quat_from_rpy, quat_rotate, rpy_from_q
 from roverlab.msgs import builders as build
 from roverlab.msgs import classes as mc
 from roverlab.msgs import xyz_to_pointcloud2
+from roverlab.perception.image_transport.node import CompressedPublisher
 from roverlab.raycast import Scene
 from roverlab.raycast.camera import camera_intrinsics, depth_to_points
 from roverlab.sim.collision import Obstacles, inner_radius
@@ -558,8 +559,9 @@ class SimulatorNode(Node):
         model = CameraModel(sensor.params, rng)
         image_pub = self.create_publisher(mc.Image, sensor.image_topic, 2)
         info_pub = self.create_publisher(mc.CameraInfo, sensor.info_topic, 2)
+        compressed = CompressedPublisher(self, sensor.image_topic, 2)  # image_transport's
 
-        pubs = (image_pub, info_pub)
+        pubs = (image_pub, info_pub, compressed)
 
         def tick() -> None:
             # rendered only while someone looks, as gazebo_ros_camera activates its sensor
@@ -568,7 +570,9 @@ class SimulatorNode(Node):
             ns = self.get_clock().now_ns()
             x, y, z, yaw, pitch = self.sensor_pose(sensor.mount)
             rgb = model.capture_rgb(self.scene, x, y, z, yaw, pitch)
-            image_pub.publish(_image(ns, sensor.frame_id, rgb, "rgb8"))
+            image = _image(ns, sensor.frame_id, rgb, "rgb8")
+            image_pub.publish(image)
+            compressed.publish(image)
             info_pub.publish(self._camera_info(ns, sensor.frame_id, model, sensor))
 
         self.create_timer(1.0 / sensor.update_rate_hz, tick)
@@ -580,9 +584,10 @@ class SimulatorNode(Node):
         depth_pub = self.create_publisher(mc.Image, sensor.depth_topic, 2)
         dinfo_pub = self.create_publisher(mc.CameraInfo, sensor.depth_info_topic, 2)
         points_pub = self.create_publisher(mc.PointCloud2, sensor.points_topic, 2)
+        compressed = CompressedPublisher(self, sensor.image_topic, 2)
         p = sensor.params
 
-        pubs = (image_pub, info_pub, depth_pub, dinfo_pub, points_pub)
+        pubs = (image_pub, info_pub, depth_pub, dinfo_pub, points_pub, compressed)
 
         def tick() -> None:
             if not any(pub.has_listeners for pub in pubs):  # as the colour camera
@@ -590,7 +595,9 @@ class SimulatorNode(Node):
             ns = self.get_clock().now_ns()
             x, y, z, yaw, pitch = self.sensor_pose(sensor.mount)
             rgb, depth = model.capture(self.scene, x, y, z, yaw, pitch)
-            image_pub.publish(_image(ns, sensor.frame_id, rgb, "rgb8"))
+            image = _image(ns, sensor.frame_id, rgb, "rgb8")
+            image_pub.publish(image)
+            compressed.publish(image)
             depth_pub.publish(_image(ns, sensor.frame_id, depth, "32FC1"))
             info = self._camera_info(ns, sensor.frame_id, model, sensor)
             info_pub.publish(info)

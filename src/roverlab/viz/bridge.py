@@ -21,7 +21,6 @@ import math
 import re
 import threading
 import time
-from collections import deque
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, Final
@@ -71,7 +70,7 @@ from roverlab.viz.protocol import (
     robot_outlines,
     robot_shapes,
 )
-from roverlab.viz.status import DisplayStatus, TopicInfo
+from roverlab.viz.status import DisplayStatus, RateMeter, TopicInfo
 
 __all__ = [
     "COMPRESSED_TYPE",
@@ -128,6 +127,8 @@ class VizBridge(DisplayStatus):
         map_dir: where the Save map button writes (map_saver's working directory).
         remote_graph: returns the other processes' publishers and subscriptions
             (:meth:`Connection.graph`); None in-process.
+        remote_counts: returns the messages the other processes published per topic
+            (:meth:`Connection.topic_counts`), for the topics' rates; None in-process.
         node_name: name of the node.
     """
 
@@ -141,6 +142,7 @@ class VizBridge(DisplayStatus):
         turn_radps: float = 0.5,
         map_dir: str | Path = ".",
         remote_graph: Callable[[], Sequence[Any]] | None = None,
+        remote_counts: Callable[[], dict[str, dict[str, int]]] | None = None,
         node_name: str = "rviz",
     ) -> None:
         self.context = context
@@ -154,8 +156,9 @@ class VizBridge(DisplayStatus):
         self._version = 0
         self._remote_graph = remote_graph
         self._remote: list[Any] = []
-        self._received: dict[str, int] = {}
-        self._rate_samples: dict[str, deque[tuple[float, int]]] = {}
+        self._remote_counts = remote_counts
+        self._rates = RateMeter(_RATE_WINDOW_S)  # counted by the publishing processes
+        self._subscribed_rates = RateMeter(_RATE_WINDOW_S)  # counted by the displays
         self.outlines: Versioned | None = None
         self.shapes: list[dict[str, Any]] = []
         self.joint_sliders: JointSliders | None = None
@@ -304,7 +307,7 @@ class VizBridge(DisplayStatus):
             if state.sub_key != key:
                 return
             state.received += 1
-            self._received[topic] = self._received.get(topic, 0) + 1
+            state.last_message_s = time.monotonic()
             try:
                 handler.on_message(state, msg)
                 state.error = None
@@ -312,6 +315,7 @@ class VizBridge(DisplayStatus):
                 state.error = f"{type(err).__name__}: {err}"
 
         qos: QoSProfile | int = _LATCHED if kind == "map" else (1 if kind == "image" else 10)
+        state.subscribed_s = time.monotonic()
         return self.node.create_subscription(typename, topic, callback, qos)
 
     # -------------------------------------------------------------- callbacks
@@ -379,22 +383,37 @@ class VizBridge(DisplayStatus):
             if t.typename in (IMAGE_TYPE, COMPRESSED_TYPE) and t.publishers > 0
         )
 
-    def topic_rates(self) -> dict[str, float | None]:
-        """Messages per wall second of each topic over the last few seconds (None: not
-        measurable: no local publisher and the dashboard does not subscribe to it)."""
+    def refresh_remote_counts(self) -> None:
+        """Ask the other processes how many messages they published per topic (blocking)."""
+        if self._remote_counts is None:
+            return
+        counts = self._remote_counts()
         now = time.monotonic()
+        with self._lock:
+            for zid, topics in counts.items():
+                self._rates.observe(zid, now, topics)
+
+    def topic_rates(self) -> dict[str, float | None]:
+        """Messages per wall second of each topic over the last few seconds, counted where
+        they are published: by this process's publishers and, attached over the network,
+        by the other processes' (:meth:`refresh_remote_counts`); a topic nobody counts (a
+        publisher outside roverlab) is measured by the displays subscribed to it. None: not
+        measurable."""
+        now = time.monotonic()
+        local = {n: t.published for n, t in list(self.context.graph.topics.items()) if t.publishers}
+        received: dict[str, int] = {}
+        for d in self.displays:
+            if d.sub_key[0]:
+                received[d.sub_key[0]] = received.get(d.sub_key[0], 0) + d.received
+        with self._lock:
+            self._rates.observe("", now, local)
+            self._subscribed_rates.observe("", now, received)
+            rates = self._rates.rates(now)
+            fallback = self._subscribed_rates.rates(now)
         out: dict[str, float | None] = {}
-        for name, t in list(self.context.graph.topics.items()):
-            count = t.published if t.publishers else self._received.get(name)
-            if count is None:
-                out[name] = None
-                continue
-            samples = self._rate_samples.setdefault(name, deque())
-            samples.append((now, count))
-            while len(samples) > 2 and now - samples[0][0] > _RATE_WINDOW_S:
-                samples.popleft()
-            t0, c0 = samples[0]
-            out[name] = round((count - c0) / (now - t0), 2) if now - t0 > 0.2 else None
+        for name in list(self.context.graph.topics) + list(rates):
+            value = rates.get(name, fallback.get(name))
+            out[name] = None if value is None else round(value, 2)
         return out
 
     def select_image(self, topic: str) -> None:

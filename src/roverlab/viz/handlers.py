@@ -80,6 +80,8 @@ class DisplayState:
         map_base: a map display's last full frame; ``map_patches`` follow it.
         status: status-tree rows ``name -> (level, text)``, level ``ok|warn|error``.
         received: messages received since subscribing.
+        subscribed_s: when it subscribed (``time.monotonic()``), None if it is not.
+        last_message_s: when its newest message arrived (``time.monotonic()``).
         info: small per-display data for the JSON state (e.g. a map's frame).
     """
 
@@ -93,6 +95,8 @@ class DisplayState:
     map_msg: Any = None
     status: dict[str, tuple[str, str]] = field(default_factory=dict)
     received: int = 0
+    subscribed_s: float | None = None
+    last_message_s: float | None = None
     info: dict[str, Any] = field(default_factory=dict)
     sub: Any = None
     sub_key: tuple[str, str] = ("", "")

@@ -18,6 +18,8 @@ from pathlib import Path
 from typing import Final
 
 from roverlab.core import Context, Node
+from roverlab.core.transport.zenoh import GraphEntity, ZenohTransport, query_graph
+from roverlab.core.transport.zenoh_stats import query_topic_counts
 from roverlab.viz.config import (
     ConfigError,
     DashboardConfig,
@@ -114,7 +116,16 @@ def start_rviz(
     from roverlab.viz.server import DashboardServer  # FastAPI: only when a node asks for it
 
     host, choice = _dashboard_address()
-    server = DashboardServer(context, host, choice.port, config=config, node_name=node_name)
+    graph, counts = _remote_sources(context)
+    server = DashboardServer(
+        context,
+        host,
+        choice.port,
+        config=config,
+        node_name=node_name,
+        remote_graph=graph,
+        remote_counts=counts,
+    )
     try:
         start_page(server, choice, say=lambda text: warn(f"{where}rviz: {text}"))
     except DashboardError as err:
@@ -132,6 +143,33 @@ def _dashboard_address() -> tuple[str, PortChoice]:
         DashboardError: the port is not a number.
     """
     return os.environ.get("ROVERLAB_DASHBOARD_HOST", "127.0.0.1"), choose_port(None)
+
+
+def _remote_sources(
+    context: Context,
+) -> tuple[Callable[[], list[GraphEntity]], Callable[[], dict[str, dict[str, int]]]]:
+    """The other processes' graph and message counts, through the launch's Zenoh transport
+    (when its topics are exposed; looked up at each call: it may be added after the node),
+    so a launch's rviz shows what other terminals publish as ``roverlab dashboard`` does."""
+
+    def transport() -> ZenohTransport | None:
+        return next((t for t in context.transports if isinstance(t, ZenohTransport)), None)
+
+    def graph() -> list[GraphEntity]:
+        t = transport()
+        if t is None:
+            return []
+        return [e for e in query_graph(t.session, t.domain) if e.zid != t.zid]
+
+    def counts() -> dict[str, dict[str, int]]:
+        t = transport()
+        if t is None:
+            return {}
+        out = query_topic_counts(t.session, t.domain)
+        out.pop(t.zid, None)
+        return out
+
+    return graph, counts
 
 
 def image_view_config(topic: str | None) -> DashboardConfig:
@@ -171,8 +209,15 @@ def start_image_view(
     from roverlab.viz.server import DashboardServer  # FastAPI: only when a node asks for it
 
     host, choice = _dashboard_address()
+    graph, counts = _remote_sources(context)
     server = DashboardServer(
-        context, host, choice.port, config=image_view_config(topic), node_name=node_name
+        context,
+        host,
+        choice.port,
+        config=image_view_config(topic),
+        node_name=node_name,
+        remote_graph=graph,
+        remote_counts=counts,
     )
     try:
         server.start(next_free=True)  # beside an rviz of the same launch on that port

@@ -67,6 +67,7 @@ STATIC_DIR: Final = Path(__file__).parent / "static"
 _START_TIMEOUT_S: Final = 10.0
 _TOPICS_EVERY_S: Final = 1.0
 _REMOTE_GRAPH_EVERY_S: Final = 2.0
+_REMOTE_COUNTS_EVERY_S: Final = 1.0
 DEFAULT_CONFIG_NAME: Final = "dashboard.json"
 
 
@@ -103,6 +104,8 @@ class DashboardServer:
         map_dir: where the page's *Save map* writes ``NAME.pgm`` + ``NAME.yaml``.
         remote_graph: the other processes' graph (:meth:`Connection.graph`), polled
             every 2 s for the topic list; None in-process.
+        remote_counts: the other processes' messages per topic
+            (:meth:`Connection.topic_counts`), polled every second for the topics' rates.
         state_rate_hz: how often poses and the robot outline are sent.
         node_name: the dashboard node's name (destroying it stops the server).
 
@@ -122,6 +125,7 @@ class DashboardServer:
         config_path: str | Path | None = None,
         map_dir: str | Path = ".",
         remote_graph: Callable[[], Sequence[Any]] | None = None,
+        remote_counts: Callable[[], dict[str, dict[str, int]]] | None = None,
         state_rate_hz: float = 10.0,
         node_name: str = "rviz",
     ) -> None:
@@ -145,6 +149,7 @@ class DashboardServer:
             config=config,
             map_dir=map_dir,
             remote_graph=remote_graph,
+            remote_counts=remote_counts,
             node_name=node_name,
         )
         self.bridge.node.on_destroy.append(self.stop)
@@ -391,7 +396,7 @@ class DashboardServer:
                 sock.close()
                 raise DashboardError(f"dashboard could not serve on {self.host}:{self.port}")
             time.sleep(0.02)
-        if self.bridge._remote_graph is not None:
+        if self.bridge._remote_graph is not None or self.bridge._remote_counts is not None:
             self._graph_thread = threading.Thread(
                 target=self._poll_graph, name="roverlab-dashboard-graph", daemon=True
             )
@@ -433,10 +438,15 @@ class DashboardServer:
         return sock
 
     def _poll_graph(self) -> None:
+        next_graph = 0.0
         while not self._stopping.is_set():
-            with contextlib.suppress(Exception):  # a network hiccup: keep the last graph
-                self.bridge.refresh_remote_graph()
-            self._stopping.wait(_REMOTE_GRAPH_EVERY_S)
+            if time.monotonic() >= next_graph:
+                next_graph = time.monotonic() + _REMOTE_GRAPH_EVERY_S
+                with contextlib.suppress(Exception):  # a network hiccup: keep the last graph
+                    self.bridge.refresh_remote_graph()
+            with contextlib.suppress(Exception):
+                self.bridge.refresh_remote_counts()
+            self._stopping.wait(_REMOTE_COUNTS_EVERY_S)
 
     def stop(self) -> None:
         """Stop serving and wait for the thread."""

@@ -16,6 +16,8 @@ Key layout (``D`` is the domain, ``ROVERLAB_DOMAIN_ID``, default 0; like ``ROS_D
 ``rl/D/p/<node>``                      parameter service of a node (JSON queries)
 ``rl/D/v/<service>``                   a service server's queryable (CDR request and
                                        response): :mod:`.zenoh_services`
+``rl/D/stats/<zid>``                   messages published per topic by a process
+                                       (ROS 1's ``getBusStats``): :mod:`.zenoh_stats`
 =====================================  ================================================
 
 Messages that stay inside a process never touch Zenoh: a topic is serialised only while
@@ -47,6 +49,7 @@ from roverlab.core.transport.zenoh_graph import (
 )
 from roverlab.core.transport.zenoh_latched import LatchedInbox, Source, parse_tag, tag
 from roverlab.core.transport.zenoh_services import ZenohServices
+from roverlab.core.transport.zenoh_stats import declare_stats
 from roverlab.msgs import deserialize, serialize
 
 if TYPE_CHECKING:
@@ -264,6 +267,7 @@ class ZenohTransport:
         self._services = ZenohServices(self)
         self._clock_watch: Any = None
         self._clock_sources: dict[str, str] = {}  # zid -> node of other /clock publishers
+        self._stats: Any = None
 
     @property
     def context(self) -> Context | None:
@@ -284,6 +288,15 @@ class ZenohTransport:
     # ----------------------------------------------------------------- Transport protocol
     def attach(self, context: Context) -> None:
         self._context = context
+        if self._stats is None:
+            self._stats = declare_stats(self.session, self.domain, self.zid, self._published)
+
+    def _published(self) -> dict[str, int]:
+        """Messages published per topic with a publisher here (read on Zenoh's thread)."""
+        ctx = self._context
+        if ctx is None:
+            return {}
+        return {n: t.published for n, t in list(ctx.graph.topics.items()) if t.publishers}
 
     def on_node(self, node: Node, added: bool) -> None:
         fq = node.get_fully_qualified_name()
@@ -420,6 +433,7 @@ class ZenohTransport:
     def close(self) -> None:
         self._services.close()
         self._clock_watch = None
+        self._stats = None
         with self._lock:
             self._links.clear()
             self._node_entities.clear()

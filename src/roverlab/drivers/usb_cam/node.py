@@ -34,6 +34,7 @@ from roverlab.drivers.usb_cam.calibration import CameraCalibration, load_calibra
 from roverlab.drivers.usb_cam.capture import IO_METHODS, FrameSource, open_source
 from roverlab.msgs import array_to_image
 from roverlab.msgs import classes as mc
+from roverlab.perception.image_transport.node import CompressedPublisher
 
 __all__ = ["UsbCamNode"]
 
@@ -87,6 +88,7 @@ class UsbCamNode(Node):
             raise ParameterError(f"{node_name}: framerate must be > 0, got {self.framerate}")
         self.calibration = self._load_calibration(info_url) if info_url else None
         self._image_pub = self.create_publisher(mc.Image, "~/image_raw", 1)
+        self._compressed_pub = CompressedPublisher(self, "~/image_raw")  # image_transport's
         self._info_pub = self.create_publisher(mc.CameraInfo, "~/camera_info", 1)
         self.create_service("std_srvs/srv/Empty", "~/start_capture", self._on_start)
         self.create_service("std_srvs/srv/Empty", "~/stop_capture", self._on_stop)
@@ -173,6 +175,7 @@ class UsbCamNode(Node):
         encoding = "mono8" if frame.ndim == 2 else "rgb8"
         image = array_to_image(frame, encoding, frame_id=self.frame_id, stamp=stamp)
         self._image_pub.publish(image)
+        self._compressed_pub.publish(image)  # only while someone subscribes
         self._info_pub.publish(self.camera_info(int(image.width), int(image.height), stamp))
         self.frames_published += 1
 

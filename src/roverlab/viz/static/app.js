@@ -193,6 +193,9 @@
       if (!el) return;
       const old = el.src;
       el.src = URL.createObjectURL(new Blob([new Uint8Array(buf, 4)], { type: mime }));
+      el.classList.add("shown");  // the panel's message gives way to the picture
+      const msg = el.parentElement.querySelector(".imgmsg");
+      if (msg) msg.textContent = "";
       if (old.startsWith("blob:")) URL.revokeObjectURL(old);
       return;  // the image panel, not the view
     }

@@ -246,6 +246,7 @@ window.vizPanel = ({ $, view, data, send, redraw, requestDraw, configHooks, pain
       const st = el.querySelector(".status");
       st.innerHTML = ""; st.appendChild(statusHtml(rows));
       el.dataset.status = worst(rows);
+      imageMessage(slot, rows);
     });
   }
 
@@ -284,8 +285,11 @@ window.vizPanel = ({ $, view, data, send, redraw, requestDraw, configHooks, pain
       cm.onchange = () => { d.options.color_map = cm.value; sendConfig(); renderDisplays(); };
       row.append(sel, cm);
       const img = document.createElement("img"); img.dataset.slot = slot; img.alt = d.name;
-      if (first) { sel.id = "image-topic"; img.id = "camera"; first = false; }
-      div.append(row, img); box.appendChild(div);
+      // rqt_image_view's empty canvas says why: no topic, no publisher, not an image, ...
+      const msg = document.createElement("div"); msg.className = "imgmsg"; msg.dataset.slot = slot;
+      msg.textContent = d.topic ? `Waiting for images on ${d.topic}` : "Pick an image topic";
+      if (first) { sel.id = "image-topic"; img.id = "camera"; msg.id = "camera-message"; first = false; }
+      div.append(row, msg, img); box.appendChild(div);
     });
     if (first) {  // no image display: a picker that makes one
       const sel = document.createElement("select"); sel.id = "image-topic"; sel.className = "image-topic";
@@ -293,6 +297,18 @@ window.vizPanel = ({ $, view, data, send, redraw, requestDraw, configHooks, pain
       const row = document.createElement("div"); row.className = "row"; row.append(sel); box.appendChild(row);
     }
     renderImageTopics(data.state ? data.state.image_topics || [] : []);
+  }
+  // an image display with no picture yet shows its status in the panel instead
+  function imageMessage(slot, rows) {
+    const d = data.config.displays[slot];
+    if (!d || d.kind !== "image") return;
+    const msg = document.querySelector(`.imgmsg[data-slot="${slot}"]`);
+    const img = document.querySelector(`img[data-slot="${slot}"]`);
+    if (!msg || !img || img.classList.contains("shown")) return;
+    const bad = rows.filter((r) => r[0] === "warn" || r[0] === "error").map((r) => r[2]);
+    if (!d.topic) msg.textContent = "Pick an image topic";
+    else if (bad.length) msg.textContent = bad.join("; ");
+    else msg.textContent = `Waiting for images on ${d.topic}`;
   }
   function renderImageTopics(topics) {
     for (const sel of document.querySelectorAll("select.image-topic")) {
@@ -306,7 +322,9 @@ window.vizPanel = ({ $, view, data, send, redraw, requestDraw, configHooks, pain
     const t = $("topics");
     const rows = data.topics.map((x) => {
       const hz = x.hz === null || x.hz === undefined ? "-" : x.hz.toFixed(1);
-      return `<tr class="${x.publishers ? "" : "none"}" title="${x.type}: ${x.publishers} publisher(s), ${x.subscribers} subscriber(s)"><td>${x.name}</td><td class="hz">${hz} Hz</td></tr>`;
+      // live when it has a publisher or messages flow (a publisher the graph does not show yet)
+      const live = x.publishers > 0 || x.hz > 0;
+      return `<tr class="${live ? "" : "none"}" title="${x.type}: ${x.publishers} publisher(s), ${x.subscribers} subscriber(s)"><td>${x.name}</td><td class="hz">${hz} Hz</td></tr>`;
     });
     t.innerHTML = rows.join("");
   }
