@@ -87,7 +87,7 @@ def test_launch_pages_follow_the_rule(taken: int, monkeypatch: pytest.MonkeyPatc
     ctx.shutdown()
 
 
-def test_image_view_on_a_taken_port_is_one_line(taken: int, daemon: str) -> None:
+def test_image_view_on_a_taken_port_is_one_line(taken: int) -> None:
     run = subprocess.run(
         [sys.executable, "-m", "roverlab.cli", "image", "view", "/image_raw"],
         capture_output=True,

@@ -15,7 +15,7 @@ from roverlab.cli.common import Connection, HostOption, network_options
 from roverlab.viz.config import DashboardConfig, default_config, load_config
 from roverlab.viz.errors import DashboardError
 from roverlab.viz.launcher import image_view_config
-from roverlab.viz.ports import choose_port, start_page
+from roverlab.viz.ports import check_port, choose_port, start_page
 from roverlab.viz.server import DashboardServer
 
 __all__ = ["PortOption", "dashboard", "image_app", "image_view", "load_dashboard_config"]
@@ -97,6 +97,7 @@ def _serve(
     map_dir: Path,
 ) -> None:
     choice = choose_port(port)
+    check_port(host, choice)  # before the network: a taken port fails at once
     with Connection(network_options(ctx)) as conn:
         server = DashboardServer(
             conn.context,

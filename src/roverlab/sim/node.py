@@ -571,7 +571,8 @@ class SimulatorNode(Node):
             x, y, z, yaw, pitch = self.sensor_pose(sensor.mount)
             rgb = model.capture_rgb(self.scene, x, y, z, yaw, pitch)
             image = _image(ns, sensor.frame_id, rgb, "rgb8")
-            image_pub.publish(image)
+            if image_pub.has_listeners:  # as image_transport: each transport to its readers
+                image_pub.publish(image)
             compressed.publish(image)
             info_pub.publish(self._camera_info(ns, sensor.frame_id, model, sensor))
 

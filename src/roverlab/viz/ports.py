@@ -9,7 +9,9 @@ way to the next free one, and the caller says so (:func:`start_page`). 0 picks a
 
 from __future__ import annotations
 
+import errno
 import os
+import socket
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Final, Protocol
@@ -21,6 +23,7 @@ __all__ = [
     "PORT_ENV",
     "PortChoice",
     "PortTakenError",
+    "check_port",
     "choose_port",
     "start_page",
 ]
@@ -78,6 +81,37 @@ def choose_port(option: int | None, *, option_name: str = "--port") -> PortChoic
     return choice
 
 
+def _taken(choice: PortChoice) -> PortTakenError:
+    return PortTakenError(
+        f"port {choice.port} ({choice.source}) is taken: another dashboard or program "
+        f"serves there; choose another with --port N or {PORT_ENV}=N (0: any free port)",
+        choice.port,
+    )
+
+
+def check_port(host: str, choice: PortChoice) -> None:
+    """Fail at once, before a command connects to the network, when the user's port is
+    taken (:func:`start_page` checks again when it binds).
+
+    Raises:
+        PortTakenError: ``choice`` is the user's and something listens there.
+    """
+    if not choice.chosen or choice.port == 0:
+        return
+    try:
+        infos = socket.getaddrinfo(host, choice.port, type=socket.SOCK_STREAM)
+    except OSError:
+        return  # a bad host is the server's to report
+    family, _, _, _, address = infos[0]
+    with socket.socket(family, socket.SOCK_STREAM) as sock:
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        try:
+            sock.bind(address)
+        except OSError as err:
+            if err.errno == errno.EADDRINUSE:
+                raise _taken(choice) from err
+
+
 class _Page(Protocol):
     port: int
 
@@ -96,12 +130,7 @@ def start_page(page: _Page, choice: PortChoice, *, say: Callable[[str], None]) -
         page.start(next_free=not choice.chosen)
     except PortTakenError as err:
         if choice.chosen:
-            raise PortTakenError(
-                f"port {choice.port} ({choice.source}) is taken: another dashboard or "
-                f"program serves there; choose another with --port N or {PORT_ENV}=N "
-                "(0: any free port)",
-                choice.port,
-            ) from err
+            raise _taken(choice) from err
         raise
     if page.port != choice.port and choice.port != 0:
         say(

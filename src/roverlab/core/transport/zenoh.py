@@ -471,7 +471,7 @@ class ZenohTransport:
 
         link.publisher = zpub
         link.matching = zpub.declare_matching_listener(on_matching)
-        if zpub.matching_status:
+        if zpub.matching_status.matching:  # (the status object itself is always truthy)
             topic.remote_send = send
 
     def _on_sample(self, topic: Any, sample: Any) -> None:

@@ -28,10 +28,12 @@ def declare_stats(
     """Answer statistics queries with ``counts()`` (called on Zenoh's thread: it must only
     read)."""
 
-    def on_query(query: zenoh.Query) -> None:
-        query.reply(query.key_expr, json.dumps(counts()))
+    key = stats_key(domain, zid)
 
-    return session.declare_queryable(stats_key(domain, zid), on_query)
+    def on_query(query: zenoh.Query) -> None:
+        query.reply(key, json.dumps(counts()))  # its own key: the asker tells them apart
+
+    return session.declare_queryable(key, on_query)
 
 
 def query_topic_counts(
