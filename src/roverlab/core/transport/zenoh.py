@@ -471,7 +471,8 @@ class ZenohTransport:
 
         link.publisher = zpub
         link.matching = zpub.declare_matching_listener(on_matching)
-        if zpub.matching_status.matching:  # (the status object itself is always truthy)
+        status: Any = zpub.matching_status  # a MatchingStatus (the stubs say bool): always
+        if status.matching:  # truthy itself, so its .matching is what tells
             topic.remote_send = send
 
     def _on_sample(self, topic: Any, sample: Any) -> None:
