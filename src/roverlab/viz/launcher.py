@@ -15,7 +15,7 @@ import os
 import shlex
 from collections.abc import Callable
 from pathlib import Path
-from typing import Final
+from typing import TYPE_CHECKING, Final
 
 from roverlab.core import Context, Node
 from roverlab.core.transport.zenoh import GraphEntity, ZenohTransport, query_graph
@@ -29,6 +29,9 @@ from roverlab.viz.config import (
 )
 from roverlab.viz.errors import DashboardError
 from roverlab.viz.ports import PortChoice, choose_port, start_page
+
+if TYPE_CHECKING:
+    from roverlab.viz.server import DashboardServer
 
 __all__ = [
     "RvizArgs",
@@ -113,19 +116,7 @@ def start_rviz(
         config = default_config(parsed.fixed_frame or "map")
     elif parsed.fixed_frame:
         config.fixed_frame = parsed.fixed_frame
-    from roverlab.viz.server import DashboardServer  # FastAPI: only when a node asks for it
-
-    host, choice = _dashboard_address()
-    graph, counts = _remote_sources(context)
-    server = DashboardServer(
-        context,
-        host,
-        choice.port,
-        config=config,
-        node_name=node_name,
-        remote_graph=graph,
-        remote_counts=counts,
-    )
+    server, choice = _launch_server(context, config, node_name)
     try:
         start_page(server, choice, say=lambda text: warn(f"{where}rviz: {text}"))
     except DashboardError as err:
@@ -136,13 +127,29 @@ def start_rviz(
     return server.bridge.node
 
 
-def _dashboard_address() -> tuple[str, PortChoice]:
-    """``$ROVERLAB_DASHBOARD_HOST`` (default 127.0.0.1) and the port rule's port.
+def _launch_server(
+    context: Context, config: DashboardConfig, node_name: str
+) -> tuple[DashboardServer, PortChoice]:
+    """A launch's page (not started): on ``$ROVERLAB_DASHBOARD_HOST`` (default 127.0.0.1)
+    and the port rule's port, reading the other processes through the launch's transport.
 
     Raises:
         DashboardError: the port is not a number.
     """
-    return os.environ.get("ROVERLAB_DASHBOARD_HOST", "127.0.0.1"), choose_port(None)
+    from roverlab.viz.server import DashboardServer  # FastAPI: only when a node asks for it
+
+    choice = choose_port(None)
+    graph, counts = _remote_sources(context)
+    server = DashboardServer(
+        context,
+        os.environ.get("ROVERLAB_DASHBOARD_HOST", "127.0.0.1"),
+        choice.port,
+        config=config,
+        node_name=node_name,
+        remote_graph=graph,
+        remote_counts=counts,
+    )
+    return server, choice
 
 
 def _remote_sources(
@@ -206,19 +213,7 @@ def start_image_view(
     where = f"{source}: " if source else ""
     positional = [a for a in shlex.split(args) if not a.startswith("-")]
     topic = positional[0] if positional else remaps.get("image") or remaps.get("/image")
-    from roverlab.viz.server import DashboardServer  # FastAPI: only when a node asks for it
-
-    host, choice = _dashboard_address()
-    graph, counts = _remote_sources(context)
-    server = DashboardServer(
-        context,
-        host,
-        choice.port,
-        config=image_view_config(topic),
-        node_name=node_name,
-        remote_graph=graph,
-        remote_counts=counts,
-    )
+    server, _ = _launch_server(context, image_view_config(topic), node_name)
     try:
         server.start(next_free=True)  # beside an rviz of the same launch on that port
     except DashboardError as err:
