@@ -13,6 +13,7 @@ Screenshots go to the test's tmp dir.
 from __future__ import annotations
 
 import os
+import signal
 import subprocess
 import sys
 import time
@@ -41,7 +42,9 @@ SEED_001 = """<launch>
   <include file="$(find mycar)/launch/sensor.launch"/>
 </launch>
 """
-FLOWING = ("/scan", "/odom", "/tf", "/clock", "/joint_states")
+# flowing: read by someone (the dashboard, the launch's nodes); /clock pauses while nobody
+# follows it and the cameras render only for their readers, as they should
+FLOWING = ("/scan", "/odom", "/tf", "/joint_states", "/camera/image_raw/compressed")
 
 
 @pytest.fixture(scope="module")
@@ -86,7 +89,9 @@ def seed001(daemon: str, tmp_path_factory: pytest.TempPathFactory) -> Iterator[s
         _wait_http(f"http://127.0.0.1:{port}/config", timeout_s=90.0)
         yield f"http://127.0.0.1:{port}/"
     finally:
-        for p in reversed(procs):
+        for p in procs:  # both stop at once, then each is waited for
+            p.send_signal(signal.SIGINT)
+        for p in procs:
             _stop(p)
 
 
