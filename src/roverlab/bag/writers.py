@@ -23,6 +23,7 @@ from abc import ABC, abstractmethod
 from pathlib import Path
 from typing import IO, Any, Final
 
+import lz4.frame
 from mcap.writer import CompressionType
 from mcap.writer import Writer as McapWriter
 from rosbags.interfaces import Connection
@@ -249,6 +250,21 @@ class McapBagWriter(BagWriter):
             self.part.unlink()
 
 
+def _roslz4_compress(data: bytes) -> bytes:
+    """An LZ4 frame as ROS 1's roslz4 writes and reads it: independent 1 MB blocks, a content
+    checksum and no content size (rosbags' default frames make Debian's rosbag fail with
+    "malformed data to decompress")."""
+    return bytes(
+        lz4.frame.compress(
+            data,
+            block_size=lz4.frame.BLOCKSIZE_MAX1MB,
+            block_linked=False,
+            content_checksum=True,
+            store_size=False,
+        )
+    )
+
+
 class _Ros1(BagWriter):
     encoding = "ros1"
 
@@ -259,6 +275,8 @@ class _Ros1(BagWriter):
         self.writer = Ros1Writer(self.part)
         if compression != "none":
             self.writer.set_compression(Ros1Writer.CompressionFormat[compression.upper()])
+            if compression == "lz4":
+                self.writer.compressor = _roslz4_compress
         self.writer.open()
         self.conns: list[Connection] = []
 
