@@ -21,7 +21,6 @@ from typing import Any
 from rosbags.highlevel import AnyReader, AnyReaderError
 from rosbags.interfaces import Connection, ConnectionExtRosbag1
 from rosbags.rosbag1 import Reader as Ros1Reader
-from rosbags.rosbag1 import ReaderError as Ros1ReaderError
 
 from roverlab.bag.errors import BagError
 from roverlab.bag.ros1scan import describe_damage
@@ -210,7 +209,7 @@ class BagReader:
             reader = Ros1Reader(self.path)
             try:
                 reader.open()
-            except (Ros1ReaderError, OSError, ValueError, KeyError, IndexError) as err:
+            except Exception as err:  # a damaged file raises any of rosbags' or struct's errors
                 raise BagError(describe_damage(self.path, err)) from err
             self._stack.callback(reader.close)
             self._ros1 = reader
@@ -260,8 +259,14 @@ class BagReader:
         """The messages of ``topics`` (default all) from ``start_ns`` on, in time order."""
         wanted = [c for c in self._conns if topics is None or c.topic in topics]
         by_conn = self._by_conn
-        try:
-            for conn, t, raw in self._reader.messages(connections=wanted, start=start_ns):
-                yield BagMessage(by_conn[id(conn)], t, bytes(raw))
-        except (Ros1ReaderError, AnyReaderError, OSError, ValueError, KeyError) as err:
-            raise BagError(describe_damage(self.path, err)) from err
+        messages = self._reader.messages(connections=wanted, start=start_ns)
+        while True:
+            try:
+                conn, t, raw = next(messages)
+            except StopIteration:
+                return
+            except Exception as err:  # a damaged file raises any of rosbags' or struct's errors
+                if self.format != "ros1":
+                    raise BagError(f"{self.path}: cannot read a message: {err}") from err
+                raise BagError(describe_damage(self.path, err)) from err
+            yield BagMessage(by_conn[id(conn)], t, bytes(raw))
