@@ -25,6 +25,7 @@ from roverlab.bag.reader import BagReader
 from roverlab.core import Context, QoSProfile
 from roverlab.msgs import LaserScan, String, time_to_ns
 from roverlab.msgs.ros1 import ros1_definition
+from roverlab.slam.data.bag_logs import read_bag
 from tests.bag import ros1_tools
 from tests.helpers.procs import Proc
 
@@ -207,6 +208,9 @@ def test_real_rosbag_bags_convert_both_ways_and_lose_nothing(
         copy = convert_bag(bag, tmp_path / f"copy_{comp}.bag").path
         assert _summary(_decoded(mcap)) == original
         assert _summary(_decoded(back)) == original
+        for path in (bag, back):  # what `roverlab slam run` reads: every scan, its odometry
+            poses = [r.odom_pose.x for r in read_bag(path)]
+            assert poses == pytest.approx([0.05 * i for i in range(20)])
         backs += [back, copy]
     seen = ros1_tools.read_with_rosbag(*backs)
     for path, got in seen.items():
