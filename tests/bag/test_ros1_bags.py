@@ -22,8 +22,17 @@ from roverlab.bag import BagError, BagRecorder
 from roverlab.bag.files import bag_info, convert_bag
 from roverlab.bag.player import Player, PlayOptions
 from roverlab.bag.reader import BagReader
+from roverlab.bag.writers import open_writer
 from roverlab.core import Context, QoSProfile
-from roverlab.msgs import LaserScan, String, time_to_ns
+from roverlab.msgs import (
+    LaserScan,
+    OccupancyGrid,
+    String,
+    TFMessage,
+    TransformStamped,
+    array_to_occupancy_grid,
+    time_to_ns,
+)
 from roverlab.msgs.ros1 import ros1_definition
 from roverlab.slam.data.bag_logs import read_bag
 from tests.bag import ros1_tools
@@ -291,3 +300,42 @@ def test_sim_record_bag_agrees_with_debian_rosbag(tmp_path: Path, master: int) -
             echo.kill()
             echo.wait()
     assert "child_frame_id" in out, err
+
+
+def test_a_late_subscriber_gets_the_newest_latched_map(tmp_path: Path) -> None:
+    """rosbag play latches a topic's newest message per recorded publisher: a display that
+    subscribes after the maps were played draws the last /map whole, never an early one."""
+    bag = tmp_path / "maps.bag"
+    out = open_writer(bag)
+    maps = out.add_topic("/map", "nav_msgs/OccupancyGrid", latched=True, callerid="/slam")
+    statics = [
+        out.add_topic("/tf_static", "tf2_msgs/TFMessage", latched=True, callerid=f"/pub{i}")
+        for i in range(2)
+    ]
+    for i in range(3):
+        grid = array_to_occupancy_grid(np.full((4, 4 + i), i, np.int8), resolution=0.05)
+        out.write(maps, 10**9 * (i + 1), grid)
+    for i, handle in enumerate(statics):
+        tf = TFMessage(transforms=[TransformStamped(child_frame_id=f"c{i}")])
+        out.write(handle, 10**9, tf)
+    out.finish()
+    ctx = Context(clock="wall")
+    ctx.spin_in_thread()
+    assert Player(ctx, bag, PlayOptions(rate=50.0)).run(threading.Event()) == 5
+    time.sleep(0.5)  # the executor has delivered what was played
+    got: list[Any] = []
+    tfs: list[Any] = []
+
+    def late_display() -> None:  # subscribes on the executor's thread, as a node does
+        node = ctx.create_node("late_display")
+        node.create_subscription(OccupancyGrid, "/map", got.append, 10)
+        node.create_subscription(TFMessage, "/tf_static", tfs.append, 10)
+
+    ctx.executor.call_soon_threadsafe(late_display)
+    deadline = time.monotonic() + 5
+    while (not got or len(tfs) < 2) and time.monotonic() < deadline:
+        time.sleep(0.02)
+    time.sleep(0.1)
+    ctx.shutdown()
+    assert [m.info.width for m in got] == [6]
+    assert sorted(t.transforms[0].child_frame_id for t in tfs) == ["c0", "c1"]

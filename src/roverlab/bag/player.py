@@ -24,6 +24,8 @@ from roverlab.msgs import classes as mc
 __all__ = ["PlayOptions", "Player", "parse_remaps"]
 
 CLOCK_PERIOD_S = 0.01
+#: latched /tf_static messages kept for late subscribers (each holds some static transforms)
+STATIC_TF_DEPTH = 100
 
 
 def parse_remaps(items: list[str]) -> dict[str, str]:
@@ -74,7 +76,7 @@ class Player:
         self.path = Path(path)
         self.options = options
         self.node = context.create_node("rosbag2_player")
-        self._pubs: dict[str, Publisher] = {}
+        self._pubs: dict[tuple[str, str], Publisher] = {}
         self._clock_pub = (
             self.node.create_publisher(mc.Clock, "/clock", 10) if options.clock else None
         )
@@ -82,13 +84,20 @@ class Player:
         self.loops = 0
 
     def _publisher(self, conn: BagConnection) -> Publisher:
-        pub = self._pubs.get(conn.topic)
+        """One publisher per topic and recorded publisher (``callerid``), as rosbag play
+        advertises them: a latched one keeps its newest message for late subscribers (the
+        newest /map, not the first ones); /tf_static keeps every static transform."""
+        key = (conn.topic, conn.callerid)
+        pub = self._pubs.get(key)
         if pub is None:
             name = self.options.remaps.get(conn.topic, conn.topic)
-            latched = conn.latched or name in LATCHED_TOPICS
-            qos = QoSProfile(depth=100, durability="transient_local" if latched else "volatile")
+            if conn.latched or name in LATCHED_TOPICS:
+                depth = STATIC_TF_DEPTH if name == "/tf_static" else 1
+                qos = QoSProfile(depth=depth, durability="transient_local")
+            else:
+                qos = QoSProfile(depth=100)
             pub = self.node.create_publisher(conn.typename, name, qos)
-            self._pubs[conn.topic] = pub
+            self._pubs[key] = pub
         return pub
 
     def _publish_clock(self, bag_ns: int) -> None:
