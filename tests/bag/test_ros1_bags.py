@@ -36,6 +36,7 @@ from roverlab.msgs import (
 from roverlab.msgs.ros1 import ros1_definition
 from roverlab.slam.data.bag_logs import read_bag
 from tests.bag import ros1_tools
+from tests.helpers.nodes import run_main
 from tests.helpers.procs import Proc
 
 RL = [sys.executable, "-m", "roverlab.cli"]
@@ -117,7 +118,9 @@ def test_the_extension_decides_and_every_direction_converts(tmp_path: Path) -> N
         assert {c.topic: c.ext.latching for c in raw.connections}["/robot_description"] == 1
 
 
-def test_unknown_extension_or_compression_is_refused_before_anything(tmp_path: Path) -> None:
+def test_unknown_extension_or_compression_is_refused_before_anything(
+    tmp_path: Path, capfd: pytest.CaptureFixture[str]
+) -> None:
     for bad, match in [
         (tmp_path / "x.rosbag", r"x\.rosbag: unknown bag format '\.rosbag'"),
         (tmp_path / "x.txt", r"x\.txt: unknown bag format"),
@@ -127,14 +130,16 @@ def test_unknown_extension_or_compression_is_refused_before_anything(tmp_path: P
     with pytest.raises(BagError, match=r"x\.bag: a ROS 1 bag has no 'zstd' compression"):
         BagRecorder(tmp_path / "x.bag", compression="zstd")
     assert list(tmp_path.iterdir()) == []
-    r = subprocess.run(
-        [*RL, "sim", "--record", str(tmp_path / "x.rosbag"), "--duration", "1"],
-        capture_output=True,
-        text=True,
-        timeout=60,
-    )
-    assert r.returncode == 2 and r.stderr.count("\n") == 1 and "unknown bag format" in r.stderr
-    assert "simulating" not in r.stderr and list(tmp_path.iterdir()) == []
+    for argv in (
+        ["sim", "--record", str(tmp_path / "x.rosbag"), "--duration", "1"],
+        ["bag", "convert", str(tmp_path / "nothing.bag"), str(tmp_path / "out.txt")],
+        ["bag", "record", "-a", "-O", str(tmp_path / "x.bag"), "--compression", "zstd"],
+    ):
+        assert run_main(argv) == 2
+        err = capfd.readouterr().err
+        assert err.count("\n") == 1 and str(tmp_path) in err, err
+        assert "unknown bag format" in err or "no 'zstd' compression" in err, err
+        assert "simulating" not in err and list(tmp_path.iterdir()) == []
 
 
 def test_unknown_types_play_with_their_definition_else_are_skipped(tmp_path: Path) -> None:
