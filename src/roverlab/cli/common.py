@@ -310,7 +310,7 @@ class StartGuard:
         self.recorder = recorder
 
     def record(self, path: Any) -> None:
-        """Record the run to ``path`` (MCAP)."""
+        """Record the run to ``path`` (its extension decides the format: .bag, .mcap, ...)."""
         self.recorder = BagRecorder(path)
         self.context.add_transport(self.recorder)
 
