@@ -32,7 +32,7 @@ from pathlib import Path
 from typing import Any
 
 from roverlab.autonomy.story import DemoStory
-from roverlab.bag import McapRecorder
+from roverlab.bag import BagRecorder
 from roverlab.core import Context
 from roverlab.description import find_package
 from roverlab.viz.config import DisplayConfig, load_rviz
@@ -141,7 +141,7 @@ def main() -> int:
           f"{args.sim_seconds:.0f} s of simulated time, writing {out}/")  # fmt: skip
 
     context = Context(clock="sim")
-    recorder = McapRecorder(out / "run.mcap")
+    recorder = BagRecorder(out / "run.mcap")
     context.add_transport(recorder)
     config = load_rviz(find_package("robot_navigation") / "rviz" / "navigation.rviz")
     config.displays.append(

@@ -46,7 +46,7 @@ def _times(path: Path, topic: str) -> list[int]:
 def test_record_sigterm_info_and_play(
     tmp_path: Path, talker: Proc, cli: Callable[..., Any]
 ) -> None:
-    rec = Proc([*RL, "bag", "record", "-a", "-o", str(tmp_path / "run"), "-x", "^/rosout"])
+    rec = Proc([*RL, "bag", "record", "-a", "-o", str(tmp_path / "run.mcap"), "-x", "^/rosout"])
     try:
         _wait_stderr(rec, "subscribed to /chatter")
         time.sleep(2.0)
@@ -85,7 +85,7 @@ def test_record_sigterm_info_and_play(
 
 def test_kill_9_then_recover(tmp_path: Path, talker: Proc, cli: Callable[..., Any]) -> None:
     rec = Proc(
-        [*RL, "bag", "record", "/chatter", "-o", str(tmp_path / "k"), "--compression", "lz4"]
+        [*RL, "bag", "record", "/chatter", "-o", str(tmp_path / "k.mcap"), "--compression", "lz4"]
     )
     try:
         _wait_stderr(rec, "subscribed to /chatter")

@@ -12,7 +12,7 @@ from rosbags.highlevel import AnyReader
 from rosbags.rosbag1 import Writer as Ros1Writer
 from rosbags.typesys import Stores, get_typestore
 
-from roverlab.bag import BagError, McapRecorder
+from roverlab.bag import BagError, BagRecorder
 from roverlab.bag.files import bag_info, convert_bag, recover_bag
 from roverlab.core import Context
 from roverlab.msgs.factory import Image, String
@@ -35,7 +35,7 @@ def test_recorder_flushes_chunks_and_recover_keeps_all_but_the_last_second(
     recording: recover gets every message older than one flush period back."""
     ctx = Context(clock="wall")
     out = tmp_path / "run.mcap"
-    rec = McapRecorder(out, clock=time.time_ns, flush_period_s=1.0)
+    rec = BagRecorder(out, clock=time.time_ns, flush_period_s=1.0)
     ctx.add_transport(rec)
     pub = ctx.create_node("talker").create_publisher(String, "/chatter", 10)
     big = ctx.create_node("imager").create_publisher(Image, "/image", 10)
@@ -74,7 +74,7 @@ def test_recorder_flushes_chunks_and_recover_keeps_all_but_the_last_second(
 def test_recover_a_cut_chunk_and_reject_garbage(tmp_path: Path) -> None:
     ctx = Context()
     out = tmp_path / "a.mcap"
-    rec = McapRecorder(out, flush_period_s=0.0)  # a chunk per message
+    rec = BagRecorder(out, flush_period_s=0.0)  # a chunk per message
     ctx.add_transport(rec)
     pub = ctx.create_node("talker").create_publisher(String, "/chatter", 10)
     for i in range(20):
@@ -112,7 +112,7 @@ def test_info_layout_and_convert_ros1_bag(tmp_path: Path) -> None:
     assert info.messages == 5 and info.storage == "rosbag_v2"
     assert info.duration_s == pytest.approx(0.4)
     out = tmp_path / "new.mcap"
-    assert convert_bag(ros1, out) == 5
+    assert convert_bag(ros1, out).messages == 5
     lines = bag_info(out).lines()
     assert lines[2].split() == ["Storage", "id:", "mcap"]
     assert lines[3] == "Duration:          0.400000000s"
@@ -122,7 +122,8 @@ def test_info_layout_and_convert_ros1_bag(tmp_path: Path) -> None:
     with AnyReader([out]) as reader:
         texts = [reader.deserialize(raw, c.msgtype).data for c, _, raw in reader.messages()]
     assert texts == [f"m{i}" for i in range(5)]
-    with pytest.raises(BagError, match=r"must be an \.mcap file"):
-        convert_bag(ros1, tmp_path / "x.bag")
+    with pytest.raises(BagError, match=r"x\.txt: unknown bag format '\.txt'"):
+        convert_bag(ros1, tmp_path / "x.txt")
+    assert not (tmp_path / "x.txt").exists()
     with pytest.raises(BagError, match=r"nothere\.mcap: no such file"):
         bag_info(tmp_path / "nothere.mcap")

@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from roverlab.bag import McapRecorder
+from roverlab.bag import BagRecorder
 from roverlab.core import Context, QoSProfile
 from roverlab.core.transport.zenoh import ZenohOptions, ZenohTransport
 from roverlab.msgs import classes as mc
@@ -44,7 +44,7 @@ def _live_run(bag: Path) -> Any:
         spawn=SpawnPose(-1.0, 0.0, 0.0),
         seed=1,
     )
-    ctx.add_transport(McapRecorder(bag))
+    ctx.add_transport(BagRecorder(bag))
     node = SlamGMapping(ctx, parameter_overrides=GMAPPING)
     cmd = ctx.create_node("driver").create_publisher(Twist, "/cmd_vel", 1)
     for v, w, secs in [(0.0, 0.6, 4.0), (0.25, 0.0, 3.0), (0.0, -0.6, 3.0)]:

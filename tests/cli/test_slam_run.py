@@ -169,14 +169,14 @@ def test_graph_node_settings_are_named_as_ignored_offline() -> None:
 @pytest.mark.parametrize("method", ["hector", "gmapping", "graph"])
 def test_a_simulator_recording_maps_the_maze(tmp_path: Path, method: str) -> None:
     """A recording of ``roverlab sim`` (odometry from TF) -> ``slam run`` -> ``slam mapeval``."""
-    from roverlab.bag import McapRecorder
+    from roverlab.bag import BagRecorder
     from roverlab.core import Context
     from roverlab.msgs import Twist
     from roverlab.sim.app import Simulation
 
     rec = tmp_path / "sim.mcap"
     context = Context(clock="sim")
-    context.add_transport(McapRecorder(rec))
+    context.add_transport(BagRecorder(rec))
     Simulation(context=context, world="maze", robot="mybot", cameras=False)
     driver = context.create_node("driver")
     pub = driver.create_publisher(Twist, "/cmd_vel", 10)

@@ -1,5 +1,7 @@
-"""Recording and playing back topics (rosbag / ros2 bag)."""
+"""Recording, playing, converting and repairing bags (rosbag / ros2 bag): ROS 1 ``.bag``,
+MCAP and ROS 2 bag folders, the format chosen by the file's extension."""
 
-from roverlab.bag.recorder import BagError, McapRecorder
+from roverlab.bag.errors import BagError
+from roverlab.bag.recorder import BagRecorder
 
-__all__ = ["BagError", "McapRecorder"]
+__all__ = ["BagError", "BagRecorder"]

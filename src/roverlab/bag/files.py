@@ -1,45 +1,42 @@
-"""Reading bags: ``ros2 bag info``, ``convert`` and ``rosbag reindex``'s role (recover).
+"""Whole-bag operations: ``ros2 bag info``, ``convert`` and ``rosbag reindex`` (recover).
 
-Every reader goes through rosbags' :class:`~rosbags.highlevel.AnyReader`, so a ROS 1
-``.bag``, a ROS 2 bag (sqlite3 or MCAP folder) and a single ``.mcap`` file are all inputs.
-Output is always one MCAP file with ROS 2 CDR messages and ``ros2msg`` schemas, written to a
-temporary name and renamed.
+Inputs are a ROS 1 ``.bag``, a ROS 2 bag (sqlite3 or MCAP folder) or a single ``.mcap`` file
+(:class:`~roverlab.bag.reader.BagReader`); the output's extension decides its format
+(:mod:`roverlab.bag.writers`). Outputs are written to a temporary name and renamed.
 """
 
 from __future__ import annotations
 
-import contextlib
 import datetime as dt
-import os
-from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import IO, Any
+from typing import Any
 
 from mcap.records import Channel, Message, Schema
 from mcap.stream_reader import StreamReader
-from mcap.writer import CompressionType, Writer
-from rosbags.highlevel import AnyReader, AnyReaderError
 
-from roverlab.bag.recorder import BagError
-from roverlab.msgs import STORE
+from roverlab.bag.errors import BagError
+from roverlab.bag.reader import BagConnection, BagReader, input_path
+from roverlab.bag.ros1scan import MAGIC as ROS1_MAGIC
+from roverlab.bag.ros1scan import scan_bag
+from roverlab.bag.writers import (
+    BagWriter,
+    McapBagWriter,
+    check_output,
+    open_writer,
+    output_path,
+)
+from roverlab.msgs import MessageError
 
 __all__ = [
     "BagInfo",
-    "BagMessage",
+    "Converted",
+    "Recovered",
     "TopicInfo",
     "bag_info",
     "convert_bag",
-    "open_reader",
-    "read_messages",
     "recover_bag",
 ]
-
-_COMPRESSION = {
-    "zstd": CompressionType.ZSTD,
-    "lz4": CompressionType.LZ4,
-    "none": CompressionType.NONE,
-}
 
 
 @dataclass(frozen=True)
@@ -111,38 +108,10 @@ def _size(n: int) -> str:
     return f"{n} B"
 
 
-def _check_input(path: Path) -> Path:
-    if path.name.endswith(".part"):
-        raise BagError(
-            f"{path}: an unfinished recording (the recorder was killed); "
-            f"run `roverlab bag recover {path}` first"
-        )
-    if not path.exists():
-        raise BagError(f"{path}: no such file or directory")
-    if path.is_file() and path.suffix.lower() == ".db3":  # a ROS 2 bag named by its database
-        return path.parent
-    return path
-
-
-@contextlib.contextmanager
-def open_reader(path: str | Path) -> Iterator[AnyReader]:
-    """An opened rosbags AnyReader for a .bag, a ROS 2 bag folder or a .mcap file."""
-    p = _check_input(Path(path))
-    try:
-        reader = AnyReader([p], default_typestore=STORE.typestore)
-        reader.open()
-    except (AnyReaderError, OSError, ValueError, KeyError) as err:
-        raise BagError(f"{p}: cannot read as a ROS bag or MCAP file: {err}") from err
-    try:
-        yield reader
-    finally:
-        reader.close()
-
-
-def _storage(path: Path) -> str:
-    if path.is_dir():
-        return "sqlite3" if any(path.glob("*.db3")) else "mcap"
-    return {".bag": "rosbag_v2", ".mcap": "mcap"}.get(path.suffix.lower(), "unknown")
+def _storage(reader: BagReader) -> str:
+    if reader.format == "ros2":
+        return "sqlite3" if any(reader.path.glob("*.db3")) else "mcap"
+    return {"ros1": "rosbag_v2", "mcap": "mcap"}[reader.format]
 
 
 def _bytes(path: Path) -> int:
@@ -153,118 +122,102 @@ def _bytes(path: Path) -> int:
 
 def bag_info(path: str | Path) -> BagInfo:
     """Duration, start, end, message count and per-topic type/count/format of a bag."""
-    p = Path(path)
-    with open_reader(p) as reader:
-        ros1 = reader.is2 is False
-        topics: dict[str, list[Any]] = {}
+    with BagReader(path) as reader:
+        topics: dict[str, list[BagConnection]] = {}
         for c in reader.connections:
             topics.setdefault(c.topic, []).append(c)
         infos = [
             TopicInfo(
                 name=name,
-                typename=conns[0].msgtype,
-                count=sum(c.msgcount for c in conns),
-                serialization="ros1" if ros1 else "cdr",
+                typename=conns[0].typename,
+                count=sum(c.count for c in conns),
+                serialization=conns[0].encoding,
             )
             for name, conns in sorted(topics.items())
         ]
         return BagInfo(
-            path=p,
-            storage=_storage(_check_input(p)),
-            size_bytes=_bytes(_check_input(p)),
-            start_ns=reader.start_time if reader.message_count else 0,
-            end_ns=reader.end_time - 1 if reader.message_count else 0,  # rosbags: last + 1
+            path=Path(path),
+            storage=_storage(reader),
+            size_bytes=_bytes(reader.path),
+            start_ns=reader.start_ns,
+            end_ns=reader.end_ns,
             messages=reader.message_count,
             topics=infos,
         )
 
 
-def read_messages(
-    reader: AnyReader, topics: list[str] | None = None, start_ns: int | None = None
-) -> Iterator[BagMessage]:
-    """The messages of an opened bag in time order, as ROS 2 CDR (ROS 1 data converted)."""
-    conns = [c for c in reader.connections if topics is None or c.topic in topics]
-    ts = reader.typestore
-    for conn, t, raw in reader.messages(connections=conns, start=start_ns):
-        data = raw if reader.is2 else ts.ros1_to_cdr(raw, conn.msgtype)
-        yield BagMessage(conn.topic, conn.msgtype, t, bytes(data))
+@dataclass(frozen=True)
+class Converted:
+    """What :func:`convert_bag` wrote, and the connections it could not convert."""
+
+    path: Path
+    messages: int
+    skipped: list[tuple[BagConnection, int]]
 
 
-def _schema_text(reader: AnyReader, typename: str) -> str:
-    text, _ = reader.typestore.generate_msgdef(typename, ros_version=2)
-    return str(text)
+def _same_file(a: Path, b: Path) -> bool:
+    try:
+        return a.resolve() == b.resolve()
+    except OSError:
+        return False
 
 
-class _McapOut:
-    """An MCAP file written to ``OUT.tmp`` and renamed on :meth:`finish`."""
+def convert_bag(src: str | Path, dst: str | Path, *, compression: str | None = None) -> Converted:
+    """Copy a bag of any format into another; the output's extension decides its format
+    (see :mod:`roverlab.bag.writers`). Messages keep their times; a ROS 1 -> ROS 1 copy
+    keeps the bytes (``Header.seq`` included) and the connections' definitions.
 
-    def __init__(self, path: Path, compression: str) -> None:
-        if compression not in _COMPRESSION:
-            raise BagError(f"unknown compression {compression!r} (zstd, lz4 or none)")
-        self.path = path
-        self.tmp = path.with_name(path.name + ".tmp")
+    Connections whose type cannot be decoded (unknown and without a definition, or a
+    definition other than roverlab's) are copied as bytes between ROS 1 bags, else skipped
+    and returned in :attr:`Converted.skipped`.
+
+    Raises:
+        BagError: Unknown output extension or compression, unreadable input, output = input.
+    """
+    check_output(dst, compression)
+    src_path = input_path(src)
+    if _same_file(src_path, output_path(dst)):
+        raise BagError(f"{dst}: is the input; convert writes a new bag, never in place")
+    with BagReader(src_path) as reader:
+        out = open_writer(dst, compression)
+        handles: dict[int, int] = {}
+        skipped: dict[int, list[Any]] = {}
         try:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            self.fh: IO[bytes] = open(self.tmp, "wb")  # noqa: SIM115 - closed in finish()
-        except OSError as err:
-            raise BagError(f"{path}: cannot write: {err.strerror}") from err
-        self.writer = Writer(self.fh, compression=_COMPRESSION[compression])
-        self.writer.start(profile="ros2", library="roverlab")
-        self.schemas: dict[str, int] = {}
-        self.channels: dict[tuple[str, str], int] = {}
-        self.count = 0
-
-    def channel(self, topic: str, typename: str, schema_text: str) -> int:
-        key = (topic, typename)
-        if key not in self.channels:
-            if typename not in self.schemas:
-                self.schemas[typename] = self.writer.register_schema(
-                    name=typename, encoding="ros2msg", data=schema_text.encode()
-                )
-            self.channels[key] = self.writer.register_channel(
-                topic=topic, message_encoding="cdr", schema_id=self.schemas[typename]
-            )
-        return self.channels[key]
-
-    def write(self, channel: int, log_ns: int, publish_ns: int, data: bytes) -> None:
-        self.writer.add_message(
-            channel_id=channel, log_time=log_ns, publish_time=publish_ns, data=data
-        )
-        self.count += 1
-
-    def finish(self) -> None:
-        self.writer.finish()
-        self.fh.flush()
-        os.fsync(self.fh.fileno())
-        self.fh.close()
-        os.replace(self.tmp, self.path)
-
-    def abort(self) -> None:
-        self.fh.close()
-        with contextlib.suppress(OSError):
-            self.tmp.unlink()
-
-
-def convert_bag(src: str | Path, dst: str | Path, *, compression: str = "zstd") -> int:
-    """Copy a ROS 1 .bag, ROS 2 bag or MCAP file into one MCAP file (ROS 2 CDR); returns the
-    number of messages written."""
-    out_path = Path(dst)
-    if out_path.suffix.lower() != ".mcap":
-        raise BagError(f"{out_path}: the output must be an .mcap file")
-    with open_reader(src) as reader:
-        out = _McapOut(out_path, compression)
-        try:
-            texts: dict[str, str] = {}
-            for msg in read_messages(reader):
-                if msg.typename not in texts:
-                    texts[msg.typename] = _schema_text(reader, msg.typename)
-                ch = out.channel(msg.topic, msg.typename, texts[msg.typename])
-                out.write(ch, msg.log_time_ns, msg.log_time_ns, msg.cdr)
+            for msg in reader.messages():
+                conn = msg.connection
+                key = id(conn)
+                handle = handles.get(key)
+                if handle is None:
+                    if key in skipped:
+                        skipped[key][1] += 1
+                        continue
+                    if conn.problem and not (conn.encoding == out.encoding == "ros1"):
+                        skipped[key] = [conn, 1]
+                        continue
+                    handle = handles[key] = _add_topic(out, conn)
+                try:
+                    out.write_raw(handle, msg.log_time_ns, msg.data, conn.encoding)
+                except MessageError as err:
+                    raise BagError(
+                        f"{reader.path}: a {conn.typename} on {conn.topic} at "
+                        f"{msg.log_time_ns / 1e9:.9f} s cannot be converted: {err}"
+                    ) from err
         except BaseException:
             out.abort()
             raise
         out.finish()
-        return out.count
+        return Converted(out.path, out.count, [(c, int(n)) for c, n in skipped.values()])
+
+
+def _add_topic(out: BagWriter, conn: BagConnection) -> int:
+    ros1 = conn.ros1 if conn.encoding == "ros1" else None
+    return out.add_topic(
+        conn.topic,
+        conn.typename,
+        latched=conn.latched,
+        callerid=conn.callerid or "/roverlab",
+        ros1=ros1,
+    )
 
 
 @dataclass(frozen=True)
@@ -275,56 +228,103 @@ class Recovered:
     dropped_bytes: int
 
 
-def recover_bag(part: str | Path, out: str | Path | None = None) -> Recovered:
-    """Write a readable MCAP with every complete chunk of an unfinished recording.
+def _recover_output(src: Path, out: str | Path | None, ext: str) -> Path:
+    if out is not None:
+        dst = Path(out)
+    elif src.name.endswith(".part"):
+        dst = src.with_name(src.name[: -len(".part")])
+    else:  # a damaged finished bag: a new file beside it, never in place
+        dst = src.with_name(f"{src.stem}.reindexed{ext}")
+    if not dst.name.lower().endswith(ext):
+        dst = dst.with_name(dst.name + ext)
+    if _same_file(src, dst):
+        raise BagError(f"{dst}: is the input; recover writes a new bag, never in place")
+    return dst
 
-    ``part`` is what a killed recorder left (``NAME.mcap.part``): a header, complete chunks
-    and then at most one cut record. The output (default: ``NAME.mcap``) has the schemas,
-    channels and messages of every complete record, in their order.
+
+def recover_bag(part: str | Path, out: str | Path | None = None) -> Recovered:
+    """Write a readable bag with every whole chunk of an unfinished or damaged recording
+    (``rosbag reindex``'s role, into a new file: the input is never changed).
+
+    ``part`` is what a killed recorder left (``NAME.mcap.part``, ``NAME.bag.part``: a header,
+    whole chunks, then at most one cut record) or a damaged ``.bag``. The output (default
+    ``NAME.mcap`` / ``NAME.bag``, or ``NAME.reindexed.bag`` beside a damaged bag) has the
+    connections and messages of every whole chunk, in their order.
+
+    Raises:
+        BagError: No such file, or nothing in it is a bag.
     """
     src = Path(part)
     if not src.is_file():
         raise BagError(f"{src}: no such file")
-    if out is None:
-        name = src.name[: -len(".part")] if src.name.endswith(".part") else src.name + ".recovered"
-        dst = src.with_name(name if name.endswith(".mcap") else name + ".mcap")
-    else:
-        dst = Path(out)
+    with open(src, "rb") as fh:
+        magic = fh.read(len(ROS1_MAGIC))
+    if magic == ROS1_MAGIC or src.name.lower().endswith((".bag", ".bag.part")):
+        return _reindex_ros1(src, _recover_output(src, out, ".bag"))
+    return _recover_mcap(src, _recover_output(src, out, ".mcap"))
+
+
+def _reindex_ros1(src: Path, dst: Path) -> Recovered:
+    scan = scan_bag(src)
+    if scan.damage is not None and scan.damage.offset == 0:
+        raise BagError(f"{src}: {scan.damage}")
+    result = open_writer(dst, part_suffix=".recovering")  # NAME.part may be the input
+    try:
+        handles: dict[int, int] = {}
+        for conn_id, conn in scan.connections.items():
+            handles[conn_id] = result.add_topic(
+                conn.topic,
+                conn.typename,
+                latched=conn.latching,
+                callerid=conn.callerid or "/roverlab",
+                ros1=(conn.definition, conn.md5sum),
+            )
+        for conn_id, t, data in scan.messages:
+            handle = handles.get(conn_id)
+            if handle is not None:
+                result.write_raw(handle, t, data, "ros1")
+    except BaseException:
+        result.abort()
+        raise
+    result.finish()
+    return Recovered(dst, result.count, scan.chunks, max(0, scan.size - scan.read_to))
+
+
+def _recover_mcap(src: Path, dst: Path) -> Recovered:
     size = src.stat().st_size
-    result = _McapOut(dst, "zstd")
-    schemas: dict[int, Schema] = {}
-    channels: dict[int, Channel] = {}
+    result = open_writer(dst, "zstd", part_suffix=".recovering")  # NAME.part may be the input
+    assert isinstance(result, McapBagWriter)
+    copier = _McapCopier(result)
     chunks = 0
     try:
         with open(src, "rb") as fh:
             reader = StreamReader(fh, skip_magic=False, emit_chunks=False, validate_crcs=True)
-            records = reader.records
             pending: list[Message] = []  # the messages of the chunk being read
             read_to = fh.tell()
             try:
-                for rec in records:
+                for rec in reader.records:
                     if isinstance(rec, Schema):
-                        schemas[rec.id] = rec
+                        copier.schemas[rec.id] = rec
                     elif isinstance(rec, Channel):
-                        channels[rec.id] = rec
+                        copier.channels[rec.id] = rec
                     elif isinstance(rec, Message):
                         pending.append(rec)
                     else:  # a record after a chunk's messages: the chunk was whole
                         if pending:
                             chunks += 1
-                        _write_pending(result, pending, schemas, channels)
+                        copier.write(pending)
                         pending = []
                         read_to = fh.tell()  # the end of the last whole record
                 if pending:  # the file ended cleanly after a chunk
                     chunks += 1
-                    _write_pending(result, pending, schemas, channels)
+                    copier.write(pending)
             except Exception as err:  # a cut file ends in any of mcap's, struct's, zstd's errors
-                if not pending and result.count == 0 and not schemas:
+                if not pending and result.count == 0 and not copier.schemas:
                     raise BagError(f"{src}: not an MCAP recording ({err})") from err
                 # a chunk is decoded whole before its messages come out: `pending` is whole
                 if pending:
                     chunks += 1
-                    _write_pending(result, pending, schemas, channels)
+                    copier.write(pending)
             else:
                 read_to = fh.tell()
     except BaseException:
@@ -334,15 +334,25 @@ def recover_bag(part: str | Path, out: str | Path | None = None) -> Recovered:
     return Recovered(dst, result.count, chunks, max(0, size - read_to))
 
 
-def _write_pending(
-    out: _McapOut, pending: list[Message], schemas: dict[int, Schema], channels: dict[int, Channel]
-) -> None:
-    for m in pending:
-        ch = channels.get(m.channel_id)
-        if ch is None:
-            continue
-        schema = schemas.get(ch.schema_id)
-        typename = schema.name if schema else ""
-        text = schema.data.decode() if schema else ""
-        cid = out.channel(ch.topic, typename, text)
-        out.write(cid, m.log_time, m.publish_time, m.data)
+class _McapCopier:
+    """Copies MCAP message records, with their schemas and channels, into a new file."""
+
+    def __init__(self, out: McapBagWriter) -> None:
+        self.out = out
+        self.schemas: dict[int, Schema] = {}
+        self.channels: dict[int, Channel] = {}
+        self.handles: dict[tuple[str, str], int] = {}
+
+    def write(self, pending: list[Message]) -> None:
+        for m in pending:
+            ch = self.channels.get(m.channel_id)
+            if ch is None:
+                continue
+            schema = self.schemas.get(ch.schema_id)
+            typename = schema.name if schema else ""
+            key = (ch.topic, typename)
+            handle = self.handles.get(key)
+            if handle is None:
+                text = schema.data.decode() if schema else ""
+                handle = self.handles[key] = self.out.add_channel(ch.topic, typename, text)
+            self.out.write_record(handle, m.log_time, m.publish_time, m.data)

@@ -13,15 +13,18 @@ from typing import Annotated
 
 import typer
 
+from roverlab.bag.errors import BagError
 from roverlab.bag.files import bag_info, convert_bag, recover_bag
 from roverlab.bag.player import Player, PlayOptions, parse_remaps
-from roverlab.bag.recorder import BagError, McapRecorder
+from roverlab.bag.recorder import BagRecorder
+from roverlab.bag.writers import check_output
 from roverlab.cli.common import Connection, network_options, stop_on_signals
 from roverlab.core.graph import resolve_name
 
 app = typer.Typer(
-    help="Record and play topics in MCAP files; inspect, convert and recover bags "
-    "(ros2 bag / rosbag).",
+    help="Record and play topics; inspect, convert and reindex bags (rosbag / ros2 bag). "
+    "The extension decides the format: .bag = ROS 1 bag, .mcap = MCAP, a folder or .db3 = "
+    "ROS 2 bag.",
     no_args_is_help=True,
 )
 
@@ -30,9 +33,11 @@ _DISCOVERY_PERIOD_S = 0.5
 
 def _output_path(name: str | None) -> Path:
     if name is None:
-        name = f"rosbag2_{dt.datetime.now():%Y_%m_%d-%H_%M_%S}"
-    p = Path(name)
-    return p if p.suffix.lower() == ".mcap" else p.with_name(p.name + ".mcap")
+        return Path(f"rosbag2_{dt.datetime.now():%Y_%m_%d-%H_%M_%S}.mcap")
+    return Path(name)
+
+
+_FORMATS_HELP = ".bag = ROS 1 bag, .mcap = MCAP, a folder or .db3 = ROS 2 bag"
 
 
 @app.command("record")
@@ -47,7 +52,10 @@ def record(
     output: Annotated[
         str | None,
         typer.Option(
-            "--output", "-o", help="Bag name: NAME.mcap (default rosbag2_DATE_TIME.mcap)."
+            "--output",
+            "-o",
+            "-O",
+            help=f"The bag to write ({_FORMATS_HELP}; default rosbag2_DATE_TIME.mcap).",
         ),
     ] = None,
     exclude: Annotated[
@@ -58,17 +66,23 @@ def record(
         float | None, typer.Option("--duration", "-d", help="Stop after S seconds.")
     ] = None,
     compression: Annotated[
-        str, typer.Option("--compression", help="Chunk compression: zstd, lz4 or none.")
-    ] = "zstd",
+        str | None,
+        typer.Option(
+            "--compression",
+            help="Chunk compression: bz2 or lz4 for .bag (default none, as rosbag), "
+            "zstd (default), lz4 or none for .mcap, zstd or none for ROS 2 bags.",
+        ),
+    ] = None,
     use_sim_time: Annotated[
         bool,
         typer.Option("--use-sim-time", help="Stamp messages with /clock time, not wall time."),
     ] = False,
 ) -> None:
-    """Record topics of the running system to one MCAP file (ros2 bag record -s mcap).
+    """Record topics of the running system to a bag (rosbag record / ros2 bag record).
 
     SIGINT, SIGTERM and SIGHUP finish the file; chunks are flushed every second, so after
-    a kill -9 `roverlab bag recover NAME.mcap.part` gets all but the last second back.
+    a kill -9 `roverlab bag recover NAME.bag.part` (or .mcap.part) gets all but the last
+    second back.
     """
     if not all_topics and not topics:
         raise BagError("give topics to record, or -a for every topic")
@@ -80,9 +94,10 @@ def record(
         raise BagError(f"--exclude {exclude!r} is not a regular expression: {err}") from None
     wanted = None if all_topics else {resolve_name(t) for t in topics or []}
     path = _output_path(output)
+    check_output(path, compression)  # one clear line before joining the network
     with stop_on_signals(threading.Event()) as stop:
         conn = Connection(network_options(ctx), clock="external" if use_sim_time else "wall")
-        recorder = McapRecorder(
+        recorder = BagRecorder(
             path,
             compression=compression,
             clock=None if use_sim_time else time.time_ns,
@@ -126,7 +141,7 @@ def record(
 @app.command("play", context_settings={"allow_extra_args": True})
 def play(
     ctx: typer.Context,
-    bag: Annotated[Path, typer.Argument(help="A .mcap file, a ROS 1 .bag or a ROS 2 bag folder.")],
+    bag: Annotated[Path, typer.Argument(help="A ROS 1 .bag, a .mcap file or a ROS 2 bag folder.")],
     rate: Annotated[float, typer.Option("--rate", "-r", help="Playback speed factor.")] = 1.0,
     clock: Annotated[
         bool,
@@ -160,7 +175,7 @@ def play(
     )
     bag_info(bag)  # one clear error before joining the network
     with stop_on_signals(threading.Event()) as stop, Connection(network_options(ctx)) as conn:
-        player = Player(conn.context, bag, options)
+        player = Player(conn.context, bag, options, warn=lambda line: typer.echo(line, err=True))
         conn.context.spin_in_thread()
         time.sleep(0.3)  # subscribers' declarations reach the new publishers
 
@@ -187,25 +202,54 @@ def info(
 
 @app.command("convert")
 def convert(
-    src: Annotated[Path, typer.Argument(help="ROS 1 .bag, ROS 2 bag (sqlite3 / MCAP) or .mcap.")],
-    dst: Annotated[Path, typer.Argument(help="The MCAP file to write.")],
-    compression: Annotated[str, typer.Option("--compression", help="zstd, lz4 or none.")] = "zstd",
-) -> None:
-    """Convert a bag to one MCAP file with ROS 2 CDR messages (ros2 bag convert)."""
-    n = convert_bag(src, dst, compression=compression)
-    typer.echo(f"wrote {n} messages to {dst}")
-
-
-@app.command("recover")
-def recover(
-    part: Annotated[Path, typer.Argument(help="The NAME.mcap.part a killed recorder left.")],
-    output: Annotated[
-        Path | None, typer.Option("--output", "-o", help="Output file (default NAME.mcap).")
+    src: Annotated[Path, typer.Argument(help="ROS 1 .bag, .mcap or ROS 2 bag (folder / .db3).")],
+    dst: Annotated[Path, typer.Argument(help=f"The bag to write: {_FORMATS_HELP}.")],
+    compression: Annotated[
+        str | None,
+        typer.Option(
+            "--compression",
+            help="bz2 or lz4 for .bag (default none); zstd (default), lz4 or none for .mcap; "
+            "zstd or none for ROS 2 bags.",
+        ),
     ] = None,
 ) -> None:
-    """Write a readable MCAP with every complete chunk of a killed recording (rosbag reindex)."""
+    """Convert a bag into another format, chosen by DST's extension (ros2 bag convert;
+    rosbag compress). Every direction: .bag <-> .mcap <-> ROS 2 bag; times are kept."""
+    done = convert_bag(src, dst, compression=compression)
+    for conn, n in done.skipped:
+        typer.echo(
+            f"{src}: skipped {n} messages on {conn.topic} [{conn.typename}]: {conn.problem}",
+            err=True,
+        )
+    typer.echo(f"wrote {done.messages} messages to {done.path}")
+
+
+def _recover(part: Path, output: Path | None) -> None:
     r = recover_bag(part, output)
     typer.echo(
         f"recovered {r.messages} messages in {r.chunks} chunks to {r.path}"
         + (f" ({r.dropped_bytes} bytes of a cut chunk dropped)" if r.dropped_bytes else "")
     )
+
+
+_RECOVER_INPUT = "The NAME.bag.part / NAME.mcap.part a killed recorder left, or a damaged .bag."
+_RECOVER_OUTPUT = "Output file (default NAME.bag / NAME.mcap; NAME.reindexed.bag for a .bag)."
+
+
+@app.command("recover")
+def recover(
+    part: Annotated[Path, typer.Argument(help=_RECOVER_INPUT)],
+    output: Annotated[Path | None, typer.Option("--output", "-o", help=_RECOVER_OUTPUT)] = None,
+) -> None:
+    """Write a new readable bag with every whole chunk of a killed or damaged recording
+    (rosbag reindex; the input is never changed)."""
+    _recover(part, output)
+
+
+@app.command("reindex")
+def reindex(
+    part: Annotated[Path, typer.Argument(help=_RECOVER_INPUT)],
+    output: Annotated[Path | None, typer.Option("--output", "-o", help=_RECOVER_OUTPUT)] = None,
+) -> None:
+    """rosbag reindex: the same as `roverlab bag recover` (a new file; the input is kept)."""
+    _recover(part, output)

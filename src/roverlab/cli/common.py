@@ -13,7 +13,7 @@ from typing import Annotated, Any
 
 import typer
 
-from roverlab.bag import McapRecorder
+from roverlab.bag import BagRecorder
 from roverlab.core import Context
 from roverlab.core.errors import TransportError
 from roverlab.core.transport.daemon import ensure_daemon
@@ -312,13 +312,13 @@ class StartGuard:
         recorder: a recording already attached, if any (or attach one with :meth:`record`).
     """
 
-    def __init__(self, context: Context, recorder: McapRecorder | None = None) -> None:
+    def __init__(self, context: Context, recorder: BagRecorder | None = None) -> None:
         self.context = context
         self.recorder = recorder
 
     def record(self, path: Any) -> None:
-        """Record the run to ``path`` (MCAP)."""
-        self.recorder = McapRecorder(path)
+        """Record the run to ``path`` (its extension decides the format: .bag, .mcap, ...)."""
+        self.recorder = BagRecorder(path)
         self.context.add_transport(self.recorder)
 
     def __enter__(self) -> StartGuard:

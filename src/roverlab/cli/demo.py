@@ -10,7 +10,7 @@ from typing import Annotated
 import typer
 
 from roverlab.autonomy.story import DemoStory
-from roverlab.bag import McapRecorder
+from roverlab.bag import BagRecorder
 from roverlab.cli.common import StartGuard, expose_if_asked, stop_on_signals
 from roverlab.cli.sim import parse_rate
 from roverlab.cli.viz import PortOption
@@ -72,7 +72,7 @@ def demo(
     configure_logging("INFO" if verbose else "ERROR")
     out.mkdir(parents=True, exist_ok=True)
     context = Context(clock="sim") if math.isinf(pace) else Context(clock="paced", rate=pace)
-    recorder = McapRecorder(out / "run.mcap")
+    recorder = BagRecorder(out / "run.mcap")
     server: DashboardServer | None = None
     with StartGuard(context, recorder):
         context.add_transport(recorder)

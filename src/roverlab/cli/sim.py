@@ -9,6 +9,7 @@ from typing import Annotated
 
 import typer
 
+from roverlab.bag.writers import check_output
 from roverlab.cli.common import (
     StartGuard,
     expose_if_asked,
@@ -82,7 +83,11 @@ def sim(
     ] = None,
     record: Annotated[
         Path | None,
-        typer.Option("--record", help="Record every topic to this MCAP file (ROS 2 CDR)."),
+        typer.Option(
+            "--record",
+            help="Record every topic to this bag: .bag = ROS 1 bag, .mcap = MCAP, "
+            "a folder or .db3 = ROS 2 bag.",
+        ),
     ] = None,
     arg: Annotated[
         list[str] | None,
@@ -120,6 +125,8 @@ def sim(
 ) -> None:
     """Simulate a robot in a world: /cmd_vel in; /odom, /tf, /scan, /imu, cameras, /clock out."""
     pace = parse_rate(rate)
+    if record is not None:
+        check_output(record)  # an unknown extension is refused before anything runs
     if duration is not None and not (duration > 0 and math.isfinite(duration)):
         raise SimulationError(f"--duration must be a positive number of seconds, got {duration}")
     configure_logging()

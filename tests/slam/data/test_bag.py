@@ -10,7 +10,7 @@ import pytest
 from rosbags.highlevel import AnyReader
 from rosbags.rosbag2 import StoragePlugin
 
-from roverlab.bag import McapRecorder
+from roverlab.bag import BagRecorder
 from roverlab.core import Context, Node
 from roverlab.geometry import SE2
 from roverlab.msgs import Twist
@@ -108,7 +108,7 @@ def test_simulator_recording(tmp_path: Path) -> None:
     """An MCAP recorded from the simulator reads back with the /odom poses at the scans."""
     path = tmp_path / "sim.mcap"
     context = Context(clock="sim")
-    context.add_transport(McapRecorder(path))
+    context.add_transport(BagRecorder(path))
     Simulation(context=context, cameras=False)
     driver = Node("driver", context=context)
     pub = driver.create_publisher("geometry_msgs/msg/Twist", "/cmd_vel", 10)
