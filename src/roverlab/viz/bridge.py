@@ -87,6 +87,8 @@ COMPRESSED_TYPE: Final = "sensor_msgs/msg/CompressedImage"
 _LATCHED: Final = QoSProfile(depth=1, durability="transient_local")
 _MAX_PATCHES: Final = 16
 _RATE_WINDOW_S: Final = 3.0
+#: /clock going back by more than this is a restarted bag or simulation (rviz resets then)
+_JUMP_BACK_NS: Final = 1_000_000_000
 _MAP_NAME: Final = re.compile(r"^[A-Za-z0-9_.-]{1,100}$")
 
 
@@ -180,6 +182,8 @@ class VizBridge(DisplayStatus):
         )
         self.cmd_vel_pub = node.create_publisher("geometry_msgs/msg/Twist", "/cmd_vel", 1)
         node.create_timer(0.1, self._refresh_markers)  # lifetimes and frame-locked markers
+        self._clock_ns: int | None = None
+        node.create_subscription("rosgraph_msgs/msg/Clock", "/clock", self._on_clock, 1)
         self._apply(self.config)
 
     # ------------------------------------------------------------------ state
@@ -319,6 +323,26 @@ class VizBridge(DisplayStatus):
         return self.node.create_subscription(typename, topic, callback, qos)
 
     # -------------------------------------------------------------- callbacks
+    def _on_clock(self, msg: Any) -> None:
+        """A bag played again (or a simulation restarted) sends /clock back in time: the
+        dashboard runs on the wall clock, so its TF buffer, holding the end of the last
+        play, would ignore every new transform as older than its cache (TF_OLD_DATA) and
+        freeze the robot. As rviz does ("Detected jump back in time. Resetting RViz."),
+        the transforms and the odometry trails are dropped; maps stay until the next one."""
+        now = Time.from_msg(msg.clock).nanoseconds
+        last = self._clock_ns
+        self._clock_ns = now
+        if last is None or now >= last - _JUMP_BACK_NS:
+            return
+        self.node.get_logger().warning(
+            f"Detected jump back in time of {(last - now) / 1e9:f}s. Resetting the dashboard."
+        )
+        self.tf_buffer.clear()
+        for d in self.displays:
+            if d.trail is not None:
+                d.trail.poses.clear()
+                d.trail.full.clear()
+
     def _refresh_markers(self) -> None:
         now_ns = self.context.now().nanoseconds
         for d in self.displays:
