@@ -8,12 +8,16 @@ import signal
 import sys
 import time
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
+import numpy as np
 import pytest
 from PIL import Image
 from rosbags.highlevel import AnyReader
 
+from roverlab.bag.reader import BagReader
 from roverlab.maps import load_map
 from tests.helpers.browser import CHROMIUM, CHROMIUM_ARGS
 from tests.helpers.procs import Proc
@@ -34,12 +38,28 @@ def _wait_exit(proc: Proc, timeout: float) -> int:
         raise
 
 
-def test_headless_demo_runs_every_stage_and_leaves_its_files(tmp_path: Path) -> None:
-    out = tmp_path / "demo"
+@dataclass(frozen=True)
+class Headless:
+    """One headless demo run, shared by the module's tests (its recording is played back)."""
+
+    out: Path
+    code: int
+    stdout: str
+    stderr: str
+
+
+@pytest.fixture(scope="module")
+def headless(tmp_path_factory: pytest.TempPathFactory) -> Headless:
+    out = tmp_path_factory.mktemp("headless") / "demo"
     proc = Proc([*DEMO, "--no-dashboard", "--rate", "max", "--places", "2", "--out", str(out)])
     code = _wait_exit(proc, 600)
     stdout = proc.rest()
-    assert code == 0, (stdout, proc.stop())
+    return Headless(out, code, stdout, proc.stop())
+
+
+def test_headless_demo_runs_every_stage_and_leaves_its_files(headless: Headless) -> None:
+    out, code, stdout = headless.out, headless.code, headless.stdout
+    assert code == 0, (stdout, headless.stderr)
     report = _report(out)
     assert report["ok"] and report["stages"] == {
         "explore": "ok", "save_map": "ok", "restart": "ok", "patrol": "ok"
@@ -158,3 +178,67 @@ def test_the_dashboard_shows_the_demo(tmp_path: Path) -> None:
     for shot in ("demo_exploring.png", "demo_patrolling.png"):
         with Image.open(shots / shot) as im:
             assert im.size == (VIEWPORT["width"], VIEWPORT["height"])
+
+
+# the newest map the page holds, the Map display's status and the play's progress
+PAGE_MAP = """() => {
+  const m = viz.data.map, st = viz.data.state, cfg = viz.data.config;
+  if (!m || !st || !cfg) return null;
+  const slot = cfg.displays.findIndex((d) => d.kind === "map" && d.topic === "/map");
+  let known = 0;
+  for (const c of m.cells) if (c !== -1) known++;
+  return { w: m.w, h: m.h, res: m.res, ox: m.ox, oy: m.oy, known,
+           status: st.status.displays[slot].map((r) => r[0]) };
+}"""
+
+
+def test_the_demo_recording_played_into_the_dashboard_shows_the_last_map(
+    headless: Headless,
+) -> None:
+    """``roverlab bag play`` of the demo's recording into a running dashboard (another
+    process): the page ends with the last /map of the recording, every cell as recorded
+    (the map grows over the play: full maps and patches), and the Map display is OK."""
+    if not CHROMIUM.exists():
+        pytest.skip("/usr/bin/chromium is absent (run scripts/install-system-deps.sh)")
+    assert headless.code == 0, headless.stderr
+    bag = headless.out / "run.mcap"
+    last: Any = None
+    with BagReader(bag) as reader:
+        for msg in reader.messages(["/map"]):
+            last = msg.decode()
+    assert last is not None
+    want = np.asarray(last.data, dtype=np.int8)
+    dashboard = Proc([sys.executable, "-m", "roverlab.cli", "dashboard", "--port", "0"])
+    pw = playwright_sync.sync_playwright().start()
+    browser = pw.chromium.launch(executable_path=str(CHROMIUM), args=CHROMIUM_ARGS)
+    try:
+        url = dashboard.wait_line(lambda s: s.startswith("dashboard: "), timeout=60).split()[1]
+        page = browser.new_page(viewport=VIEWPORT)
+        errors: list[str] = []
+        page.on("pageerror", lambda e: errors.append(str(e)))
+        page.goto(url)
+        page.evaluate(FIVE_FPS)
+        page.wait_for_function("() => window.viz && viz.data.config && viz.data.state")
+        play = Proc([sys.executable, "-m", "roverlab.cli", "bag", "play", str(bag),
+                     "-r", "50", "--topics", "/map", "/tf", "/tf_static"])  # fmt: skip
+        assert _wait_exit(play, 60) == 0, play.stop()
+        page.wait_for_function(
+            f"() => {{ const s = ({PAGE_MAP})(); return s && s.known === {int((want != -1).sum())}"
+            " && s.status.every((l) => l === 'ok'); }",
+            polling=250,
+            timeout=20000,
+        )
+        shown = page.evaluate(PAGE_MAP)
+        cells = np.asarray(page.evaluate("() => Array.from(viz.data.map.cells)"), dtype=np.int8)
+        assert not errors, errors
+    finally:
+        browser.close()
+        pw.stop()
+        dashboard.stop()
+    info = last.info
+    assert (shown["w"], shown["h"]) == (info.width, info.height)
+    assert shown["res"] == pytest.approx(info.resolution)
+    assert (shown["ox"], shown["oy"]) == pytest.approx(
+        (info.origin.position.x, info.origin.position.y)
+    )
+    assert np.array_equal(cells, want)  # every cell, known or not, as the last /map has it
