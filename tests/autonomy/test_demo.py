@@ -4,6 +4,7 @@ the dashboard in a real browser while the robot explores."""
 from __future__ import annotations
 
 import json
+import os
 import signal
 import sys
 import time
@@ -14,8 +15,10 @@ import pytest
 from PIL import Image
 from rosbags.highlevel import AnyReader
 
+from roverlab.core.transport.daemon import daemon_running
 from roverlab.maps import load_map
 from tests.helpers.browser import CHROMIUM, CHROMIUM_ARGS
+from tests.helpers.net import free_port
 from tests.helpers.procs import Proc
 from tests.viz.test_dashboard import VIEWPORT
 
@@ -26,6 +29,18 @@ def _report(out: Path) -> dict:
     return json.loads((out / "report.json").read_text())
 
 
+def _cpu_seconds(pid: int, wall_s: float) -> float:
+    """CPU seconds (user + system) process ``pid`` takes over the next ``wall_s``."""
+
+    def ticks() -> int:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+        return int(fields[11]) + int(fields[12])  # utime, stime
+
+    first = ticks()
+    time.sleep(wall_s)
+    return (ticks() - first) / os.sysconf("SC_CLK_TCK")
+
+
 def _wait_exit(proc: Proc, timeout: float) -> int:
     try:
         return proc.popen.wait(timeout=timeout)
@@ -34,9 +49,11 @@ def _wait_exit(proc: Proc, timeout: float) -> int:
         raise
 
 
-def test_headless_demo_runs_every_stage_and_leaves_its_files(tmp_path: Path) -> None:
+def test_demo_runs_every_stage_leaves_its_files_and_ends(tmp_path: Path) -> None:
+    """With its dashboard (as `make run`), the demo ends by itself once the report is
+    written."""
     out = tmp_path / "demo"
-    proc = Proc([*DEMO, "--no-dashboard", "--rate", "max", "--places", "2", "--out", str(out)])
+    proc = Proc([*DEMO, "--port", "0", "--rate", "max", "--places", "2", "--out", str(out)])
     code = _wait_exit(proc, 600)
     stdout = proc.rest()
     assert code == 0, (stdout, proc.stop())
@@ -63,14 +80,23 @@ def test_headless_demo_runs_every_stage_and_leaves_its_files(tmp_path: Path) -> 
     assert not list(out.glob("*.part"))
 
 
-def test_ctrl_c_ends_the_demo_with_its_report_and_a_complete_recording(tmp_path: Path) -> None:
+def test_ctrl_c_ends_the_demo_with_its_report_and_a_complete_recording(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Exposed on a daemon of its own that was not running: the demo starts it and, as
+    roslaunch stops the roscore it started, stops it when it ends."""
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    monkeypatch.setenv("ROVERLAB_DAEMON", endpoint)
     out = tmp_path / "demo"
-    proc = Proc([*DEMO, "--no-dashboard", "--rate", "2", "--out", str(out)])
+    proc = Proc([sys.executable, "-m", "roverlab.cli", "demo", "--expose", "--no-dashboard",
+                 "--rate", "2", "--out", str(out)])  # fmt: skip
     proc.wait_line(lambda s: s.startswith("[explore] ..."), timeout=120)
+    assert daemon_running(endpoint)
     time.sleep(3.0)
     proc.popen.send_signal(signal.SIGINT)
     code = _wait_exit(proc, 60)
     assert code == 1
+    assert not daemon_running(endpoint)
     report = _report(out)
     assert report["stages"]["explore"] == "interrupted"
     assert report["stages"]["patrol"] == "skipped" and not report["ok"]
@@ -98,13 +124,15 @@ FIVE_FPS = "() => { viz.redraw.maxFps = 5; }"
 def test_the_dashboard_shows_the_demo(tmp_path: Path) -> None:
     """The dashboard's URL comes first; the page shows the map being built, the robot and
     move_base's plan while it explores, the particle cloud while it patrols; the demo
-    reaches its report with every stage succeeding and keeps serving until Ctrl-C."""
+    reaches its report with every stage succeeding; with --stay it keeps serving the last
+    state until Ctrl-C, taking no CPU while the page is closed."""
     if not CHROMIUM.exists():
         pytest.skip("/usr/bin/chromium is absent (run scripts/install-system-deps.sh)")
     out = tmp_path / "demo"
     shots = tmp_path / "screenshots"
     shots.mkdir()
-    proc = Proc([*DEMO, "--port", "0", "--rate", "5", "--places", "2", "--out", str(out)])
+    proc = Proc([*DEMO, "--port", "0", "--rate", "5", "--places", "2", "--stay", "--out",
+                 str(out)])  # fmt: skip
     pw = playwright_sync.sync_playwright().start()
     browser = pw.chromium.launch(executable_path=str(CHROMIUM), args=CHROMIUM_ARGS)
     try:
@@ -142,10 +170,20 @@ def test_the_dashboard_shows_the_demo(tmp_path: Path) -> None:
         page.wait_for_timeout(1500)
         page.screenshot(path=str(shots / "demo_patrolling.png"))
         try:
-            proc.wait_line(line("the robot waits in the maze"), timeout=300)
+            proc.wait_line(line("the simulation is stopped; the dashboard shows"), timeout=300)
         except AssertionError as err:
             raise AssertionError(f"{err}; stdout: {''.join(seen)}") from None
         assert not errors, errors
+        # the page still has the last state (the map, the robot) after a reload
+        page.reload()
+        page.wait_for_function(
+            "() => window.viz && viz.data.map && viz.data.state && viz.data.state.robot.length > 0",
+            polling=250,
+            timeout=30000,
+        )
+        page.close()
+        time.sleep(1.0)
+        assert _cpu_seconds(proc.popen.pid, 4.0) < 0.1  # nothing runs but the web server
     finally:
         browser.close()
         pw.stop()

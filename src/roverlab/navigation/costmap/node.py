@@ -222,9 +222,12 @@ class Costmap2DROS:
             else:
                 self._waiting_for_pose(str(err))
             return None
-        self._pose_seen = True
         now = self.node.get_clock().now()
         age = (now.nanoseconds - stamp.nanoseconds) / 1e9
+        if age > p.transform_tolerance and not self._pose_seen:
+            self._waiting_for_pose(f"the transform is {age:.2f} s old")
+            return None
+        self._pose_seen = True
         if age > p.transform_tolerance:
             self._throttle.warning(
                 "stale",
@@ -237,8 +240,8 @@ class Costmap2DROS:
 
     def _waiting_for_pose(self, err: str) -> None:
         """Before the first pose, as Costmap2DROS waits for its transform at start: quiet
-        for the first seconds (the TF tree fills in as the other nodes start), then one
-        line every few seconds."""
+        for the first seconds (the TF tree fills in, and catches up, as the other nodes
+        start), then one line every few seconds."""
         now = self.node.get_clock().now_ns()
         if self._start_warning_ns is None:
             self._start_warning_ns = now + round(_START_WARN_S * 1e9)
