@@ -21,6 +21,7 @@ from roverlab.geometry.mesh import load_mesh, mesh_outlines
 from roverlab.sim.app import Simulation
 from roverlab.world import load_world, world_warnings
 from tests.helpers.collada import boxes, open_bin, open_profile, write_model
+from tests.helpers.nodes import range_at
 
 ROBOT = (
     Path(__file__).resolve().parents[1]
@@ -110,14 +111,10 @@ def test_world_of_database_models_simulates(
     finally:
         ctx.shutdown()
     scan = scans[-1]
-    ranges = np.asarray(scan.ranges)  # type: ignore[attr-defined]
-    angles = scan.angle_min + scan.angle_increment * np.arange(len(ranges))  # type: ignore[attr-defined]
-
-    def at(angle: float) -> float:
-        return float(ranges[int(np.argmin(np.abs(np.angle(np.exp(1j * (angles - angle))))))])
-
-    assert at(0.0) == pytest.approx(2.7, abs=0.05)  # the barrier's near foot, 3 m ahead
-    assert at(math.pi / 2) == pytest.approx(3.5, abs=0.05)  # the dumpster, 4 m to the left
+    assert range_at(scan, 0.0) == pytest.approx(2.7, abs=0.05)  # the barrier's near foot, 3 m ahead
+    assert range_at(scan, math.pi / 2) == pytest.approx(
+        3.5, abs=0.05
+    )  # the dumpster, 4 m to the left
 
 
 def test_mesh_that_cannot_be_processed_is_one_warning_naming_it(
