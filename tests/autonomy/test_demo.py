@@ -4,10 +4,10 @@ the dashboard in a real browser while the robot explores."""
 from __future__ import annotations
 
 import json
-import os
 import signal
 import sys
 import time
+import urllib.request
 from collections.abc import Callable
 from pathlib import Path
 
@@ -15,8 +15,12 @@ import pytest
 from PIL import Image
 from rosbags.highlevel import AnyReader
 
+from roverlab.cli.demo import _pause
+from roverlab.core import Context
 from roverlab.core.transport.daemon import daemon_running
 from roverlab.maps import load_map
+from roverlab.sim.app import Simulation
+from roverlab.viz.server import DashboardServer
 from tests.helpers.browser import CHROMIUM, CHROMIUM_ARGS
 from tests.helpers.net import free_port
 from tests.helpers.procs import Proc
@@ -29,18 +33,6 @@ def _report(out: Path) -> dict:
     return json.loads((out / "report.json").read_text())
 
 
-def _cpu_seconds(pid: int, wall_s: float) -> float:
-    """CPU seconds (user + system) process ``pid`` takes over the next ``wall_s``."""
-
-    def ticks() -> int:
-        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
-        return int(fields[11]) + int(fields[12])  # utime, stime
-
-    first = ticks()
-    time.sleep(wall_s)
-    return (ticks() - first) / os.sysconf("SC_CLK_TCK")
-
-
 def _wait_exit(proc: Proc, timeout: float) -> int:
     try:
         return proc.popen.wait(timeout=timeout)
@@ -49,11 +41,9 @@ def _wait_exit(proc: Proc, timeout: float) -> int:
         raise
 
 
-def test_demo_runs_every_stage_leaves_its_files_and_ends(tmp_path: Path) -> None:
-    """With its dashboard (as `make run`), the demo ends by itself once the report is
-    written."""
+def test_headless_demo_runs_every_stage_and_leaves_its_files(tmp_path: Path) -> None:
     out = tmp_path / "demo"
-    proc = Proc([*DEMO, "--port", "0", "--rate", "max", "--places", "2", "--out", str(out)])
+    proc = Proc([*DEMO, "--no-dashboard", "--rate", "max", "--places", "2", "--out", str(out)])
     code = _wait_exit(proc, 600)
     stdout = proc.rest()
     assert code == 0, (stdout, proc.stop())
@@ -110,6 +100,33 @@ def test_bad_arguments_are_one_line() -> None:
     code = _wait_exit(proc, 60)
     err = proc.stop()
     assert code == 2 and err.strip().splitlines() == ["error: --places must be >= 1, got 0"]
+    proc = Proc([*DEMO, "--no-dashboard", "--stay"])
+    code = _wait_exit(proc, 60)
+    assert code == 2 and proc.stop().strip().splitlines() == [
+        "error: --stay keeps the dashboard up: it cannot go with --no-dashboard"
+    ]
+
+
+def test_staying_pauses_everything_but_the_web_server() -> None:
+    """What --stay does after the report: the simulator, every node's timers and the
+    network stop; the dashboard still serves its last state; the process takes no CPU."""
+    ctx = Context(clock="paced", rate=3.0)
+    server = DashboardServer(ctx, "127.0.0.1", 0)
+    Simulation(context=ctx, world="maze", robot="mybot")
+    server.start()
+    try:
+        spinner = ctx.spin_in_thread()
+        time.sleep(1.0)
+        assert ctx.now().nanoseconds > 0  # the simulation runs
+        _pause(ctx, spinner, own_daemon=False)
+        assert not spinner.is_alive()
+        used = time.process_time()
+        time.sleep(3.0)
+        assert time.process_time() - used < 0.1  # nothing runs
+        with urllib.request.urlopen(server.url, timeout=10) as page:  # still served
+            assert page.status == 200
+    finally:
+        ctx.shutdown()
 
 
 playwright_sync = pytest.importorskip("playwright.sync_api", reason="playwright not installed")
@@ -124,15 +141,13 @@ FIVE_FPS = "() => { viz.redraw.maxFps = 5; }"
 def test_the_dashboard_shows_the_demo(tmp_path: Path) -> None:
     """The dashboard's URL comes first; the page shows the map being built, the robot and
     move_base's plan while it explores, the particle cloud while it patrols; the demo
-    reaches its report with every stage succeeding; with --stay it keeps serving the last
-    state until Ctrl-C, taking no CPU while the page is closed."""
+    reaches its report with every stage succeeding and ends by itself (as `make run`)."""
     if not CHROMIUM.exists():
         pytest.skip("/usr/bin/chromium is absent (run scripts/install-system-deps.sh)")
     out = tmp_path / "demo"
     shots = tmp_path / "screenshots"
     shots.mkdir()
-    proc = Proc([*DEMO, "--port", "0", "--rate", "5", "--places", "2", "--stay", "--out",
-                 str(out)])  # fmt: skip
+    proc = Proc([*DEMO, "--port", "0", "--rate", "5", "--places", "2", "--out", str(out)])
     pw = playwright_sync.sync_playwright().start()
     browser = pw.chromium.launch(executable_path=str(CHROMIUM), args=CHROMIUM_ARGS)
     try:
@@ -170,26 +185,16 @@ def test_the_dashboard_shows_the_demo(tmp_path: Path) -> None:
         page.wait_for_timeout(1500)
         page.screenshot(path=str(shots / "demo_patrolling.png"))
         try:
-            proc.wait_line(line("the simulation is stopped; the dashboard shows"), timeout=300)
+            proc.wait_line(line("  files: "), timeout=300)
         except AssertionError as err:
             raise AssertionError(f"{err}; stdout: {''.join(seen)}") from None
         assert not errors, errors
-        # the page still has the last state (the map, the robot) after a reload
-        page.reload()
-        page.wait_for_function(
-            "() => window.viz && viz.data.map && viz.data.state && viz.data.state.robot.length > 0",
-            polling=250,
-            timeout=30000,
-        )
-        page.close()
-        time.sleep(1.0)
-        assert _cpu_seconds(proc.popen.pid, 4.0) < 0.1  # nothing runs but the web server
+        code = _wait_exit(proc, 60)  # by itself: no Ctrl-C
     finally:
         browser.close()
         pw.stop()
         if proc.popen.poll() is None:
-            proc.popen.send_signal(signal.SIGINT)
-        code = _wait_exit(proc, 60)
+            proc.stop()
     report = _report(out)
     assert report["ok"], report["stages"]
     assert code == 0
