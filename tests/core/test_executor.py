@@ -274,3 +274,26 @@ def test_clock_pauses_without_listeners_and_resumes_for_a_late_subscriber() -> N
     ctx.spin_for(1.0)
     assert 99 <= len(stamps) <= 100
     assert stamps[0] > 1_000_000_000 and stamps[-1] <= 2_000_000_000
+
+
+def test_wait_for_from_another_thread_counts_the_time_the_executor_lived() -> None:
+    """A callback holding a paced executor for 2 s of wall time does not use up a
+    sim-time timeout another thread waits with: the simulation stood still meanwhile."""
+    ctx = Context(clock="paced", rate=10.0)
+    node = ctx.create_node("busy")
+    held: list[bool] = []
+
+    def hold() -> None:
+        if not held:
+            held.append(True)
+            time.sleep(2.0)  # e.g. a costmap's first inflation on a loaded machine
+
+    node.create_timer(0.1, hold)
+    ctx.spin_in_thread()
+    try:
+        started = time.monotonic()
+        assert not ctx.wait_for(lambda: False, 5.0)  # 5 sim s = 0.5 s wall at rate 10
+        assert time.monotonic() - started >= 2.0
+        assert ctx.executor.now_ns >= 5_000_000_000
+    finally:
+        ctx.shutdown()

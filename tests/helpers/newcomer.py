@@ -71,7 +71,7 @@ class Terminals:
 
     def type(self, name: str, command: str) -> None:
         """Type ``command`` and Enter in terminal ``name``."""
-        line = re.sub(r"^roverlab\b", _ROVERLAB, command)
+        line = re.sub(r"(^|&& )roverlab\b", lambda m: m.group(1) + _ROVERLAB, command)
         self._tmux("send-keys", "-t", f"n:{name}", "-l", line)
         self._tmux("send-keys", "-t", f"n:{name}", "Enter")
 
