@@ -75,6 +75,12 @@ class Terminals:
         self._tmux("send-keys", "-t", f"n:{name}", "-l", line)
         self._tmux("send-keys", "-t", f"n:{name}", "Enter")
 
+    def keys(self, name: str, keys: str) -> None:
+        """Press ``keys`` in terminal ``name`` (no Enter): teleop's driving keys."""
+        for key in keys:
+            self._tmux("send-keys", "-t", f"n:{name}", "-l", key)
+            time.sleep(0.3)
+
     def transcript(self, name: str) -> str:
         path = self.logs / f"{name}.log"
         text = path.read_text(errors="replace") if path.exists() else ""
