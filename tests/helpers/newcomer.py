@@ -63,7 +63,7 @@ class Terminals:
             self._tmux("new-session", "-d", "-s", "n", "-n", name, "-x", "160", "-y", "50", shell)
             self._tmux("set-option", "-g", "history-limit", "50000")
         else:
-            self._tmux("new-window", "-d", "-t", "n", "-n", name, shell)
+            self._tmux("new-window", "-d", "-t", "n:", "-n", name, shell)
         self.windows.append(name)
         log = self.logs / f"{name}.log"
         self._tmux("pipe-pane", "-o", "-t", f"n:{name}", f"cat >> {shlex.quote(str(log))}")
