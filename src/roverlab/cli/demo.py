@@ -31,7 +31,7 @@ def demo(
             help="Sim seconds per wall second: 3 (default) lets you follow it; 1 = real "
             "time; 'max' = as fast as the CPU allows. The story is about 200 simulated "
             "seconds (seed 0): at rate 3 no less than 67 s wall. Measured on a 2-core "
-            "machine shared with other jobs (load average about 10): rate 3 took 5 "
+            "machine shared with other jobs (load average 10 to 14): rate 3 took 3 to 5 "
             "minutes wall, --rate max 1.5 minutes.",
         ),
     ] = "3",
