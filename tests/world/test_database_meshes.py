@@ -21,7 +21,7 @@ from roverlab.geometry.mesh import load_mesh, mesh_outlines
 from roverlab.sim.app import Simulation
 from roverlab.world import load_world, world_warnings
 from tests.helpers.collada import boxes, open_bin, open_profile, write_model
-from tests.helpers.nodes import range_at
+from tests.helpers.nodes import collect, range_at
 
 ROBOT = (
     Path(__file__).resolve().parents[1]
@@ -104,9 +104,7 @@ def test_world_of_database_models_simulates(
     try:
         sim = Simulation(context=ctx, world=str(_world(tmp_path)), robot=str(ROBOT))
         assert world_warnings(sim.world_model) == []
-        node = ctx.create_node("collector")
-        scans: list[object] = []
-        node.create_subscription("sensor_msgs/msg/LaserScan", "/scan", scans.append, 10)
+        scans = collect(ctx, {"/scan": "sensor_msgs/msg/LaserScan"})["/scan"]
         ctx.spin_for(0.5)
     finally:
         ctx.shutdown()
