@@ -33,7 +33,8 @@ MAX_PER_MINUTE = 3
 
 @dataclass
 class Terminals:
-    """tmux windows of one private tmux server, each logging to ``logs/NAME.log``.
+    """tmux windows of one private tmux server (its socket in ``logs``), each logging to
+    ``logs/NAME.log``.
 
     Args:
         logs: folder of the transcripts.
@@ -42,13 +43,13 @@ class Terminals:
 
     logs: Path
     env: dict[str, str] = field(default_factory=dict)
-    socket: str = field(default_factory=lambda: f"roverlab-newcomer-{time.monotonic_ns()}")
     windows: list[str] = field(default_factory=list)
 
     def _tmux(self, *args: str) -> str:
         assert TMUX is not None
+        self.logs.mkdir(parents=True, exist_ok=True)
         done = subprocess.run(
-            [TMUX, "-L", self.socket, *args], capture_output=True, text=True, timeout=30
+            [TMUX, "-S", str(self.socket), *args], capture_output=True, text=True, timeout=30
         )
         if done.returncode != 0:
             raise RuntimeError(f"tmux {' '.join(args)}: {done.stderr.strip()}")
@@ -56,7 +57,6 @@ class Terminals:
 
     def open(self, name: str, command: str) -> None:
         """A new terminal ``name`` typing ``command`` (``roverlab ...`` runs this checkout)."""
-        self.logs.mkdir(parents=True, exist_ok=True)
         exports = " ".join(f"{k}={shlex.quote(v)}" for k, v in self.env.items())
         shell = f"env {exports} bash --norc --noprofile" if exports else "bash --norc"
         if not self.windows:
@@ -102,8 +102,14 @@ class Terminals:
 
     def kill(self) -> None:
         if self.windows:
-            subprocess.run([TMUX or "tmux", "-L", self.socket, "kill-server"], timeout=30)
+            subprocess.run([TMUX or "tmux", "-S", str(self.socket), "kill-server"], timeout=30)
             self.windows = []
+        self.socket.unlink(missing_ok=True)
+
+    @property
+    def socket(self) -> Path:
+        """The private tmux server's socket (beside the transcripts)."""
+        return self.logs / "tmux.sock"
 
 
 def repeated_warnings(text: str, minutes: float) -> list[str]:
