@@ -4,11 +4,13 @@ from __future__ import annotations
 
 import contextlib
 import math
+import os
 import signal
 import threading
 import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, replace
+from pathlib import Path
 from typing import Annotated, Any
 
 import typer
@@ -26,6 +28,7 @@ from roverlab.core.transport.zenoh import (
 )
 from roverlab.core.transport.zenoh_stats import query_topic_counts
 from roverlab.errors import RoverlabError
+from roverlab.packages import BUNDLED_PACKAGES_DIR
 
 __all__ = [
     "FOLLOWER_CLOCKS",
@@ -197,8 +200,13 @@ def report_warnings(title: str, lines: list[str], strict: bool) -> None:
 
 def report_notes(lines: list[str]) -> None:
     """Print what a file sets that roverlab reads and does not act on, ``note:`` a line
-    (not warnings: ``--strict`` does not refuse them)."""
+    (not warnings: ``--strict`` does not refuse them). A file of a bundled package is
+    named as ``PKG/path`` and one below the working folder by its relative path, so that a
+    note fits a terminal line."""
+    cwd = f"{Path.cwd()}{os.sep}"
+    bundled = f"{BUNDLED_PACKAGES_DIR}{os.sep}"
     for line in lines:
+        line = line.replace(bundled, "").replace(cwd, "")
         typer.echo(f"note: {line}", err=True)
 
 
