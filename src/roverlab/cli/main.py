@@ -35,6 +35,8 @@ _COMMANDS: dict[str, tuple[str, str]] = {
     "param": ("roverlab.cli.graph", "param_app"),
     "tf": ("roverlab.cli.tf", "app"),
     "daemon": ("roverlab.cli.daemon", "app"),
+    "roscore": ("roverlab.cli.roscore", "roscore"),
+    "master": ("roverlab.cli.roscore", "roscore"),
     "image": ("roverlab.cli.viz", "image_app"),
     "urdf": ("roverlab.cli.description", "app"),
     "map": ("roverlab.cli.maps", "app"),

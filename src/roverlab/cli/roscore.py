@@ -1,0 +1,56 @@
+"""``roverlab roscore`` (also ``roverlab master``): a ROS 1 master and parameter server."""
+
+from __future__ import annotations
+
+import signal
+import threading
+from typing import Annotated, Any
+
+import typer
+
+from roverlab.core.errors import TransportError
+from roverlab.core.transport.ros1.master import DEFAULT_MASTER_PORT, Master
+
+
+def roscore(
+    port: Annotated[
+        int,
+        typer.Option("--port", "-p", help="XML-RPC port of the master (ROS: roscore -p)."),
+    ] = DEFAULT_MASTER_PORT,
+    host: Annotated[
+        str,
+        typer.Option(
+            "--host",
+            help="Address to listen on and advertise (default loopback only; 0.0.0.0 or "
+            "this machine's address to let other machines in).",
+        ),
+    ] = "127.0.0.1",
+) -> None:
+    """Run a ROS 1 master: the master API (register/unregister publishers, subscribers
+    and services, lookupNode, getSystemState, ...) and the parameter server (with
+    /run_id and paramUpdate callbacks), like ros_comm's roscore / rosmaster. Real rospy
+    and roscpp nodes, rostopic, rosnode, rosparam and rosservice work against it; point
+    them (and roverlab) at it with ROS_MASTER_URI=http://127.0.0.1:PORT/.
+
+    Unlike roscore it starts no /rosout node and no launch file."""
+    try:
+        master = Master(host=host, port=port)
+    except OSError as err:
+        raise TransportError(
+            f"cannot listen on {host}:{port}: {err.strerror or err} "
+            "(another roscore running? try -p PORT)"
+        ) from None
+    stop = threading.Event()
+
+    def on_signal(*_: Any) -> None:
+        stop.set()
+
+    signal.signal(signal.SIGINT, on_signal)
+    signal.signal(signal.SIGTERM, on_signal)
+    master.start()
+    typer.echo(f"started roscore: ROS_MASTER_URI={master.uri}", err=False)
+    while not stop.wait(0.2):
+        if master.shutdown_requested.is_set():
+            break
+    master.stop()
+    typer.echo("roscore stopped")

@@ -1,0 +1,51 @@
+"""A roverlab process's ROS 1 peer against real rospy under Debian's real rosmaster:
+the slave API (requestTopic, publisherUpdate, getBusInfo, getPid) and TCPROS both ways."""
+
+from __future__ import annotations
+
+import struct
+import time
+
+from roverlab.core.transport.ros1.peer import Ros1Peer, TopicSpec
+from tests.core.ros1.conftest import SCRIPTS, run_ros, start_ros, stop
+
+STRING = TopicSpec("std_msgs/String", "992ce8a1687cec8c8bd883ec73ca41d1", "string data\n")
+
+
+def _string(text: str) -> bytes:
+    raw = text.encode()
+    return struct.pack("<I", len(raw)) + raw
+
+
+def test_peer_talks_tcpros_with_rospy_both_ways(real_master: str) -> None:
+    peer = Ros1Peer(real_master)
+    talker = start_ros(real_master, "/usr/bin/python3", str(SCRIPTS / "talker.py"), "/peer_in")
+    try:
+        got: list[bytes] = []
+        peer.subscribe("/rl_listener", "/peer_in", STRING, got.append)
+        peer.advertise("/rl_talker", "/peer_out", STRING, latched=True)
+        peer.publish("/peer_out", _string("latched hello"))  # before anyone listens
+        listener = start_ros(
+            real_master, "/usr/bin/python3", str(SCRIPTS / "listener.py"), "/peer_out", "3"
+        )
+        end = time.monotonic() + 30
+        while not peer.has_subscribers("/peer_out") and time.monotonic() < end:
+            time.sleep(0.02)
+        while listener.poll() is None and time.monotonic() < end:
+            peer.publish("/peer_out", _string("hello from roverlab"))
+            time.sleep(0.05)
+        out = listener.stdout.read() if listener.stdout else ""
+        assert listener.returncode == 0, out
+        assert out.splitlines()[0] == "latched hello"
+        end = time.monotonic() + 10
+        while len(got) < 3 and time.monotonic() < end:
+            time.sleep(0.05)
+        assert len(got) >= 3 and got[-1][4:].startswith(b"hello ")
+        info = run_ros(real_master, "/usr/bin/rosnode", "info", "/rl_listener")
+        assert "/peer_in [std_msgs/String]" in info.stdout and "Pid:" in info.stdout
+        assert "Connections:" in info.stdout
+        wrong = run_ros(real_master, "/usr/bin/rostopic", "info", "/peer_out")
+        assert "/rl_talker" in wrong.stdout
+    finally:
+        stop(talker)
+        peer.close()
