@@ -18,6 +18,7 @@ from roverlab.core import Context
 from roverlab.core.errors import TransportError
 from roverlab.core.transport.daemon import ensure_daemon
 from roverlab.core.transport.interfaces import split_wildcard_listen
+from roverlab.core.transport.ros1.transport import Ros1Transport, ros_master_uri
 from roverlab.core.transport.zenoh import (
     GraphEntity,
     ZenohOptions,
@@ -288,7 +289,14 @@ def expose_if_asked(
     """Attach ``context`` to the network (Zenoh, the command's network options) when
     :func:`choose_expose` says so, listening on ``also_listen`` too (the endpoint a
     launch's script processes join it by)."""
-    if choose_expose(expose, pace):
+    master = ros_master_uri()
+    if master is not None and choose_expose(expose, pace):
+        # ROS_MASTER_URI (or --ros-master): the run is a ROS 1 participant instead of a
+        # Zenoh one; a launch's own script processes still join it over Zenoh
+        context.add_transport(Ros1Transport(master))
+        if also_listen:
+            context.add_transport(ZenohTransport(ZenohOptions(listen=also_listen, connect=())))
+    elif choose_expose(expose, pace):
         options = network_options(ctx)
         options = replace(options, listen=(*options.listen, *also_listen))
         context.add_transport(ZenohTransport(options.zenoh_options()))

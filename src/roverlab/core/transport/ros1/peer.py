@@ -13,6 +13,7 @@ import itertools
 import logging
 import socket
 import threading
+from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -52,7 +53,7 @@ class _Pub:
     nodes: set[str] = field(default_factory=set)
     active: dict[str, OutboundLink] = field(default_factory=dict)  # subscriber callerid ->
     spare: list[OutboundLink] = field(default_factory=list)
-    last: bytes | None = None
+    latched_out: deque[bytes] = field(default_factory=lambda: deque(maxlen=1))
     on_links: Callable[[bool], None] | None = None
 
 
@@ -92,6 +93,7 @@ class Ros1Peer:
         self.on_shutdown: Callable[[str, str], None] | None = None
         self.on_param: Callable[[str, str, Any], None] | None = None
         self.closed = False
+        self._master_down = False
 
     # ------------------------------------------------------------------ nodes
     def add_node(self, name: str) -> str:
@@ -116,7 +118,14 @@ class Ros1Peer:
         return {s.uri for s in self.slaves.values()}
 
     def _master(self, method: str, *args: Any) -> Any:
-        return call(self.master_uri, method, *args, timeout_s=10.0)
+        if self.closed and self._master_down:
+            raise MasterError(f"{self.master_uri} did not answer")
+        try:
+            # closing: unregister quickly, and give up on a master that went first
+            return call(self.master_uri, method, *args, timeout_s=2.0 if self.closed else 10.0)
+        except MasterError:
+            self._master_down = self.closed
+            raise
 
     # ------------------------------------------------------------------ publishing
     def advertise(
@@ -126,17 +135,22 @@ class Ros1Peer:
         spec: TopicSpec,
         *,
         latched: bool = False,
+        latch_depth: int = 1,
         queue_size: int = 100,
         on_links: Callable[[bool], None] | None = None,
     ) -> None:
         """Register ``node`` as a publisher of ``topic``. ``on_links(True)`` is called when
-        the first subscriber connects, ``on_links(False)`` when the last one leaves."""
+        the first subscriber connects, ``on_links(False)`` when the last one leaves. A
+        latched topic repeats its last ``latch_depth`` messages to each new subscriber
+        (ROS 1 latches one per publisher; a roverlab topic may gather several nodes')."""
         uri = self.add_node(node)
         with self._lock:
             pub = self.pubs.get(topic)
             if pub is None:
                 pub = self.pubs[topic] = _Pub(spec, latched, queue_size, on_links=on_links)
             pub.latched = pub.latched or latched
+            if latched and (pub.latched_out.maxlen or 1) < latch_depth:
+                pub.latched_out = deque(pub.latched_out, maxlen=latch_depth)
             pub.nodes.add(node)
         self._master("registerPublisher", node, topic, spec.ros_type, uri)
 
@@ -163,7 +177,7 @@ class Ros1Peer:
         if pub is None:
             return
         if pub.latched:
-            pub.last = data
+            pub.latched_out.append(data)
         for link in list(pub.active.values()):
             link.send(data)
 
@@ -226,8 +240,8 @@ class Ros1Peer:
                 pub.spare.append(link)  # a second of our nodes publishing the topic
             else:
                 first = not pub.active
-                if pub.last is not None:
-                    link.send(pub.last)
+                for data in pub.latched_out:
+                    link.send(data)
                 pub.active[callerid] = link
         if first and pub.on_links is not None:
             pub.on_links(True)
