@@ -18,7 +18,7 @@ from roverlab.core import Context
 from roverlab.core.errors import TransportError
 from roverlab.core.transport.daemon import ensure_daemon
 from roverlab.core.transport.interfaces import split_wildcard_listen
-from roverlab.core.transport.ros1.transport import Ros1Transport, ros_master_uri
+from roverlab.core.transport.ros1.transport import Ros1Transport, ros1_graph, ros_master_uri
 from roverlab.core.transport.zenoh import (
     GraphEntity,
     ZenohOptions,
@@ -138,8 +138,15 @@ class Connection:
 
     def __init__(self, options: NetworkOptions, *, clock: str = "wall") -> None:
         self.context = Context(clock=clock, publish_clock=False)
-        self.transport = ZenohTransport(options.zenoh_options())
-        self.context.add_transport(self.transport)
+        self.ros1: Ros1Transport | None = None
+        self._zenoh: ZenohTransport | None = None
+        master = ros_master_uri()
+        if master is not None:  # ROS_MASTER_URI: the command is a ROS 1 node
+            self.ros1 = Ros1Transport(master)
+            self.context.add_transport(self.ros1)
+            return
+        self._zenoh = ZenohTransport(options.zenoh_options())
+        self.context.add_transport(self._zenoh)
         # A fresh session's first graph or parameter query can come back empty until it is
         # linked to the router (or a peer) and has the network's declarations: wait for
         # the link (a loaded machine can take a second), then give the declarations a
@@ -153,10 +160,26 @@ class Connection:
         time.sleep(_SETTLE_S)
         self._fresh_until = time.monotonic() + _LINK_WAIT_S
 
+    @property
+    def transport(self) -> ZenohTransport:
+        """The Zenoh transport (commands that need Zenoh itself).
+
+        Raises:
+            TransportError: the command runs as a ROS 1 node (``ROS_MASTER_URI`` is set).
+        """
+        if self._zenoh is None:
+            raise TransportError(
+                "this command does not work over ROS 1 yet: unset ROS_MASTER_URI to use "
+                "it on roverlab's own network"
+            )
+        return self._zenoh
+
     def graph(self, timeout_s: float = 1.0) -> list[GraphEntity]:
         """Nodes, publishers and subscriptions of the other processes. Shortly after
         joining, an empty answer is asked again (the declarations may still be on their
         way), so a busy machine does not make a running system look empty."""
+        if self.ros1 is not None:
+            return ros1_graph(self.ros1.master_uri, exclude=set(self.context.nodes))
         session, domain, me = self.transport.session, self.transport.domain, self.transport.zid
         while True:
             ents = [e for e in query_graph(session, domain, timeout_s) if e.zid != me]

@@ -3,6 +3,9 @@ rosmaster, rospy, rostopic), messages in ROS 1's bytes both ways, latched topics
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 import time
 from typing import Any
 
@@ -45,3 +48,60 @@ def test_roverlab_nodes_are_ros1_nodes(real_master: str) -> None:
     finally:
         stop(talker)
         transport.close()
+
+
+def test_roverlab_topic_echo_and_pub_with_rospy(real_master: str) -> None:
+    env = {**os.environ, "ROS_MASTER_URI": real_master, "ROS_HOSTNAME": "127.0.0.1"}
+    cli = [sys.executable, "-m", "roverlab.cli", "topic"]
+    talker = start_ros(real_master, "/usr/bin/python3", str(SCRIPTS / "talker.py"), "/cli_in")
+    listener = start_ros(
+        real_master, "/usr/bin/python3", str(SCRIPTS / "listener.py"), "/cli_out", "2"
+    )
+    pub = subprocess.Popen(
+        [*cli, "pub", "/cli_out", "std_msgs/String", "{data: from the cli}", "-r", "10"],
+        env=env,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    try:
+        echo = subprocess.run(
+            [*cli, "echo", "/cli_in", "-n", "2", "--timeout", "30"],
+            env=env,
+            capture_output=True,
+            text=True,
+            timeout=60,
+        )
+        assert echo.returncode == 0, echo.stderr
+        assert echo.stdout.count('data: "hello') + echo.stdout.count("data: hello") == 2
+        assert listener.wait(30) == 0
+        assert listener.stdout is not None and "from the cli" in listener.stdout.read()
+    finally:
+        for proc in (pub, talker, listener):
+            stop(proc)
+
+
+def test_real_ros1_tools_see_roverlab_sim(real_master: str) -> None:
+    env = {**os.environ, "ROS_MASTER_URI": real_master, "ROS_HOSTNAME": "127.0.0.1"}
+    sim = subprocess.Popen(
+        [sys.executable, "-m", "roverlab.cli", "sim", "--world", "empty", "--duration", "60"],
+        env=env,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    try:
+        lookup = run_ros(
+            real_master, "/usr/bin/python3", str(SCRIPTS / "tf_lookup.py"), "odom", "base_link"
+        )
+        assert lookup.returncode == 0, lookup.stderr[-2000:]
+        assert lookup.stdout.startswith("odom -> base_link: ")
+        topics = set(run_ros(real_master, "/usr/bin/rostopic", "list").stdout.split())
+        assert {"/scan", "/odom", "/tf", "/tf_static", "/clock", "/cmd_vel"} <= topics
+        scan = run_ros(real_master, "/usr/bin/rostopic", "echo", "-n", "1", "--noarr", "/scan")
+        assert "frame_id: " in scan.stdout and "range_max" in scan.stdout
+        assert (
+            run_ros(real_master, "/usr/bin/rosparam", "get", "/use_sim_time").stdout.strip()
+            == "true"
+        )
+    finally:
+        stop(sim)
+        run_ros(real_master, "/usr/bin/rosparam", "delete", "/use_sim_time")

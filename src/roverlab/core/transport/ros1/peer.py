@@ -349,7 +349,10 @@ class Ros1Peer:
                 if sub.links.get(uri) is link:
                     del sub.links[uri]
             if error is not None:
-                _log.warning("link to %s on %s ended: %s", uri, topic, error)
+                # a publisher that closes between messages has usually gone (the master
+                # will say so); anything else is worth a line
+                level = logging.DEBUG if error == "connection closed" else logging.WARNING
+                _log.log(level, "link to %s on %s ended: %s", uri, topic, error)
                 self._retry(topic, uri, callerid, backoff_s)
 
         header = {

@@ -18,6 +18,8 @@ from typing import TYPE_CHECKING, Any
 from roverlab.core.transport.ros1.errors import MasterError
 from roverlab.core.transport.ros1.peer import Ros1Peer, TopicSpec
 from roverlab.core.transport.ros1.xmlrpc import call
+from roverlab.core.transport.zenoh_graph import GraphEntity
+from roverlab.msgs import normalize_type_name
 from roverlab.msgs.ros1 import deserialize_ros1, ros1_definition, ros1_typename, serialize_ros1
 
 if TYPE_CHECKING:
@@ -25,7 +27,7 @@ if TYPE_CHECKING:
     from roverlab.core.graph import Topic
     from roverlab.core.node import Node, Publisher, Subscription
 
-__all__ = ["Ros1Transport", "ros_master_uri"]
+__all__ = ["Ros1Transport", "ros1_graph", "ros_master_uri"]
 
 _log = logging.getLogger("roverlab.ros1")
 
@@ -34,6 +36,29 @@ def ros_master_uri(explicit: str | None = None) -> str | None:
     """The ROS 1 master to join: ``explicit`` (``--ros-master``), else ``ROS_MASTER_URI``,
     else None (no ROS 1: roverlab keeps to its own transports)."""
     return explicit or os.environ.get("ROS_MASTER_URI") or None
+
+
+def ros1_graph(master_uri: str, exclude: set[str] | None = None) -> list[GraphEntity]:
+    """The nodes, publishers, subscriptions and services of a ROS 1 graph (from the
+    master's getSystemState and getTopicTypes), as the CLI reads a Zenoh graph; type
+    names in roverlab's form (``std_msgs/msg/String``). Nodes in ``exclude`` are left out.
+    """
+    skip = exclude or set()
+    pubs, subs, srvs = call(master_uri, "getSystemState", "/roverlab_cli", timeout_s=5.0)
+    types = dict(call(master_uri, "getTopicTypes", "/roverlab_cli", timeout_s=5.0))
+    out: list[GraphEntity] = []
+    nodes: set[str] = set()
+    for kind, table in (("publisher", pubs), ("subscription", subs), ("service", srvs)):
+        for name, members in table:
+            raw = types.get(name, "") if kind != "service" else ""
+            tname = normalize_type_name(raw) if raw and raw != "*" else raw
+            for node in members:
+                if node in skip:
+                    continue
+                nodes.add(node)
+                out.append(GraphEntity("ros1", kind, node, name, tname))
+    out.extend(GraphEntity("ros1", "node", n) for n in sorted(nodes))
+    return out
 
 
 def topic_spec(typename: str) -> TopicSpec:
