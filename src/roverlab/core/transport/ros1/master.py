@@ -122,7 +122,8 @@ class Master:
 
     def stop(self) -> None:
         self.notifier.close()
-        self.server.shutdown()
+        if self._thread is not None:  # shutdown() waits for a serve_forever that runs
+            self.server.shutdown()
         self.server.server_close()
 
     # ------------------------------------------------------------------ nodes

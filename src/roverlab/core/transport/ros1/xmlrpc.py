@@ -27,6 +27,7 @@ __all__ = [
     "advertised_host",
     "bind_host",
     "call",
+    "parse_reply",
     "proxy",
     "split_uri",
 ]
@@ -67,12 +68,31 @@ def call(uri: str, method: str, *args: Any, timeout_s: float = 10.0) -> Any:
         raise MasterError(f"{uri} {method}: HTTP {err.errcode} {err.errmsg}") from None
     except Exception as err:  # expat errors and odd replies from a broken peer
         raise MasterError(f"{uri} {method}: unreadable reply: {err}") from None
+    return _unpack(reply, uri, method)
+
+
+def _unpack(reply: Any, uri: str, method: str) -> Any:
     if not isinstance(reply, (list, tuple)) or len(reply) != 3:
-        raise MasterError(f"{uri} {method}: reply is not [code, status, value]: {reply!r}")
+        raise MasterError(f"{uri} {method}: reply is not [code, status, value]: {reply!r:.80}")
     code, status, value = reply
     if code != 1:
-        raise MasterError(str(status))
+        raise MasterError(str(status).strip().replace("\n", " ") or f"{method} failed")
     return value
+
+
+def parse_reply(body: bytes, uri: str = "", method: str = "") -> Any:
+    """The value of a ROS API reply's XML body (what :func:`call` returns).
+
+    Raises:
+        MasterError: not XML-RPC, a fault, or not a successful ``[code, status, value]``.
+    """
+    try:
+        (reply,), _ = xmlrpc.client.loads(body)
+    except xmlrpc.client.Fault as err:
+        raise MasterError(f"{uri} {method}: {err.faultString}".strip()) from None
+    except Exception as err:  # expat, bad numbers, wrong shapes: one line
+        raise MasterError(f"{uri} {method}: unreadable reply: {err}".strip()) from None
+    return _unpack(reply, uri, method)
 
 
 class _Handler(SimpleXMLRPCRequestHandler):
