@@ -13,6 +13,7 @@ from roverlab.core.context import Context
 from roverlab.core.qos import QoSProfile
 from roverlab.core.transport.ros1.transport import Ros1Transport
 from roverlab.msgs import classes as mc
+from roverlab.msgs import get_service_type
 from tests.core.ros1.conftest import SCRIPTS, run_ros, start_ros, stop
 
 
@@ -102,6 +103,53 @@ def test_real_ros1_tools_see_roverlab_sim(real_master: str) -> None:
             run_ros(real_master, "/usr/bin/rosparam", "get", "/use_sim_time").stdout.strip()
             == "true"
         )
+        urdf = run_ros(real_master, "/usr/bin/rosparam", "get", "/robot_description")
+        assert "<robot" in urdf.stdout  # a parameter in ROS 1, a latched topic in roverlab
     finally:
         stop(sim)
         run_ros(real_master, "/usr/bin/rosparam", "delete", "/use_sim_time")
+        run_ros(real_master, "/usr/bin/rosparam", "delete", "/robot_description")
+
+
+def test_services_both_ways_with_rospy_and_rosservice(real_master: str) -> None:
+    env = {**os.environ, "ROS_MASTER_URI": real_master, "ROS_HOSTNAME": "127.0.0.1"}
+    server = start_ros(
+        real_master, "/usr/bin/python3", str(SCRIPTS / "set_bool_server.py"), "/rospy_set"
+    )
+    ctx = Context(clock="wall")
+    transport = Ros1Transport(real_master)
+    ctx.add_transport(transport)
+    try:
+        node = ctx.create_node("rl_server")
+
+        def on_call(req: Any, resp: Any) -> Any:
+            if not req.data:
+                raise ValueError("roverlab refuses false")
+            resp.success, resp.message = True, "roverlab got true"
+            return resp
+
+        node.create_service(get_service_type("std_srvs/srv/SetBool"), "/rl_set", on_call)
+        thread = ctx.spin_in_thread()
+        info = run_ros(real_master, "/usr/bin/rosservice", "info", "/rl_set")  # a probe
+        assert "Node: /rl_server" in info.stdout and "Type: std_srvs/SetBool" in info.stdout
+        ok = run_ros(real_master, "/usr/bin/rosservice", "call", "/rl_set", "data: true")
+        assert ok.returncode == 0 and 'message: "roverlab got true"' in ok.stdout
+        bad = run_ros(real_master, "/usr/bin/rosservice", "call", "/rl_set", "data: false")
+        assert bad.returncode != 0 and "roverlab refuses false" in bad.stderr
+        assert server.stdout is not None and server.stdout.readline().strip() == "ready"
+        cli = [sys.executable, "-m", "roverlab.cli", "service", "call", "/rospy_set"]
+        got = subprocess.run(
+            [*cli, "{data: true}"], env=env, capture_output=True, text=True, timeout=60
+        )
+        assert got.returncode == 0, got.stderr
+        assert "success: true" in got.stdout and "message: rospy got true" in got.stdout
+        refused = subprocess.run(
+            [*cli, "{data: false}"], env=env, capture_output=True, text=True, timeout=60
+        )
+        assert refused.returncode == 2
+        assert refused.stderr.strip().endswith("refusing false")
+        ctx.shutdown()
+        thread.join(5)
+    finally:
+        stop(server)
+        transport.close()

@@ -20,6 +20,14 @@ from typing import Any
 
 from roverlab.core.transport.ros1.errors import HeaderError, MasterError
 from roverlab.core.transport.ros1.framing import write_header
+from roverlab.core.transport.ros1.service_link import (
+    Handler,
+    ServiceCallError,
+    ServiceSpec,
+    call_once,
+    serve_connection,
+    split_rosrpc,
+)
 from roverlab.core.transport.ros1.slave import SlaveServer
 from roverlab.core.transport.ros1.tcpros import (
     InboundLink,
@@ -29,7 +37,7 @@ from roverlab.core.transport.ros1.tcpros import (
 )
 from roverlab.core.transport.ros1.xmlrpc import advertised_host, bind_host, call
 
-__all__ = ["Ros1Peer", "TopicSpec"]
+__all__ = ["Ros1Peer", "ServiceSpec", "TopicSpec"]
 
 _log = logging.getLogger("roverlab.ros1")
 _ids = itertools.count(1)
@@ -66,6 +74,13 @@ class _Sub:
     wanted: set[str] = field(default_factory=set)
 
 
+@dataclass
+class _Srv:
+    node: str
+    spec: ServiceSpec
+    handler: Handler
+
+
 class Ros1Peer:
     """The ROS 1 side of a process, talking to the master at ``master_uri``.
 
@@ -89,6 +104,7 @@ class Ros1Peer:
         self.slaves: dict[str, SlaveServer] = {}
         self.pubs: dict[str, _Pub] = {}
         self.subs: dict[str, _Sub] = {}
+        self.services: dict[str, _Srv] = {}
         self.tcpros = TcprosServer(self.bind, self._route, self.host)
         self.on_shutdown: Callable[[str, str], None] | None = None
         self.on_param: Callable[[str, str, Any], None] | None = None
@@ -110,6 +126,8 @@ class Ros1Peer:
                 self.unadvertise(name, topic)
             for topic in [t for t, s in self.subs.items() if name in s.nodes]:
                 self.unsubscribe(name, topic)
+            for srv in [n for n, s in self.services.items() if s.node == name]:
+                self.unadvertise_service(name, srv)
             slave = self.slaves.pop(name, None)
         if slave is not None:
             slave.close()
@@ -194,9 +212,63 @@ class Ros1Peer:
     def _route(self, sock: socket.socket, header: dict[str, str]) -> None:
         if "topic" in header:
             self._accept_subscriber(sock, header)
-        else:
-            write_header(sock, {"error": "this roverlab peer serves no services yet"})
+            return
+        try:
+            name = header.get("service")
+            srv = self.services.get(name or "")
+            if srv is None:
+                write_header(sock, {"error": f"no service [{name}] here"})
+            else:
+                serve_connection(sock, header, srv.spec, srv.node, srv.handler)
+        finally:
             sock.close()
+
+    # ------------------------------------------------------------------ services
+    @property
+    def service_uri(self) -> str:
+        return f"rosrpc://{self.tcpros.host}:{self.tcpros.port}"
+
+    def advertise_service(self, node: str, name: str, spec: ServiceSpec, handler: Handler) -> None:
+        """Serve ``name`` for ``node``: ``handler(request bytes) -> (ok, bytes)`` runs in the
+        connection's thread."""
+        uri = self.add_node(node)
+        with self._lock:
+            self.services[name] = _Srv(node, spec, handler)
+        self._master("registerService", node, name, self.service_uri, uri)
+
+    def unadvertise_service(self, node: str, name: str) -> None:
+        with self._lock:
+            srv = self.services.get(name)
+            if srv is None or srv.node != node:
+                return
+            del self.services[name]
+        try:
+            self._master("unregisterService", node, name, self.service_uri)
+        except MasterError as err:
+            _log.debug("unregisterService %s: %s", name, err)
+
+    def lookup_service(self, name: str) -> str | None:
+        """The rosrpc URI of ``name``'s server in another process, or None."""
+        try:
+            uri = str(self._master("lookupService", "/roverlab", name))
+        except MasterError:
+            return None
+        return None if uri == self.service_uri else uri
+
+    def call_service(
+        self, node: str, name: str, spec: ServiceSpec, request: bytes, timeout_s: float = 60.0
+    ) -> bytes:
+        """Call ``name`` once (a fresh connection, as rospy's ServiceProxy does).
+
+        Raises:
+            ServiceCallError: no server, refused, failed, or the link broke.
+        """
+        uri = self.lookup_service(name)
+        if uri is None:
+            raise ServiceCallError(f"service [{name}] is not available")
+        host, port = split_rosrpc(uri)
+        header = {"callerid": node, "service": name, "md5sum": spec.md5sum, "persistent": "0"}
+        return call_once(host, port, header, request, timeout_s)
 
     def _accept_subscriber(self, sock: socket.socket, header: dict[str, str]) -> None:
         topic = header["topic"]

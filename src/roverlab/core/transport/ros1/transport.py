@@ -12,11 +12,19 @@ from __future__ import annotations
 
 import logging
 import os
+import threading
 from functools import partial
 from typing import TYPE_CHECKING, Any
 
+from roverlab.core.errors import ServiceError
 from roverlab.core.transport.ros1.errors import MasterError
 from roverlab.core.transport.ros1.peer import Ros1Peer, TopicSpec
+from roverlab.core.transport.ros1.service_link import (
+    ServiceCallError,
+    ServiceSpec,
+    probe,
+    service_md5,
+)
 from roverlab.core.transport.ros1.xmlrpc import call
 from roverlab.core.transport.zenoh_graph import GraphEntity
 from roverlab.msgs import normalize_type_name
@@ -26,6 +34,12 @@ if TYPE_CHECKING:
     from roverlab.core.context import Context
     from roverlab.core.graph import Topic
     from roverlab.core.node import Node, Publisher, Subscription
+    from roverlab.core.services import Client, Future, Service
+
+#: Latched topics of roverlab that ROS 1 keeps as parameters of the same name.
+_PARAM_TOPICS = frozenset({"/robot_description"})
+#: How long a ROS 1 service call may take (either way) before it fails.
+CALL_TIMEOUT_S = 60.0
 
 __all__ = ["Ros1Transport", "ros1_graph", "ros_master_uri"]
 
@@ -50,8 +64,11 @@ def ros1_graph(master_uri: str, exclude: set[str] | None = None) -> list[GraphEn
     nodes: set[str] = set()
     for kind, table in (("publisher", pubs), ("subscription", subs), ("service", srvs)):
         for name, members in table:
-            raw = types.get(name, "") if kind != "service" else ""
-            tname = normalize_type_name(raw) if raw and raw != "*" else raw
+            if kind == "service":
+                tname = _probe_service_type(master_uri, name)
+            else:
+                raw = types.get(name, "")
+                tname = normalize_type_name(raw) if raw and raw != "*" else raw
             for node in members:
                 if node in skip:
                     continue
@@ -59,6 +76,26 @@ def ros1_graph(master_uri: str, exclude: set[str] | None = None) -> list[GraphEn
                 out.append(GraphEntity("ros1", kind, node, name, tname))
     out.extend(GraphEntity("ros1", "node", n) for n in sorted(nodes))
     return out
+
+
+def _probe_service_type(master_uri: str, name: str) -> str:
+    """A service's type (``pkg/srv/Name``) from its server's probe header; "" unknown."""
+    try:
+        uri = str(call(master_uri, "lookupService", "/roverlab_cli", name, timeout_s=2.0))
+        raw = probe(uri, name, "/roverlab_cli").get("type", "")
+    except (MasterError, ServiceCallError):
+        return ""
+    pkg, sep, short = raw.partition("/")
+    return f"{pkg}/srv/{short}" if sep and "/" not in short else ""
+
+
+def service_spec(srv_type: Any) -> ServiceSpec:
+    """The ROS 1 wire description of a roverlab service type (``std_srvs/srv/SetBool``)."""
+    req_def, _ = ros1_definition(srv_type.Request.typename)
+    res_def, _ = ros1_definition(srv_type.Response.typename)
+    md5 = service_md5(req_def, res_def, lambda t: ros1_definition(t)[1])
+    pkg, _, name = str(srv_type.typename).split("/")
+    return ServiceSpec(f"{pkg}/{name}", md5, f"{pkg}/{name}Request", f"{pkg}/{name}Response")
 
 
 def topic_spec(typename: str) -> TopicSpec:
@@ -130,6 +167,8 @@ class Ros1Transport:
         if latched:
             for msg in topic.latched_history():  # published before the transport came
                 self.peer.publish(topic.name, serialize_ros1(msg, topic.typename))
+                if topic.name in _PARAM_TOPICS:
+                    self._mirror_param(topic.name, msg)
             topic.remote_send = send  # kept for late ROS 1 subscribers
 
     def _links_changed(self, topic: Topic, send: Any, connected: bool) -> None:
@@ -145,6 +184,23 @@ class Ros1Transport:
     def _send(self, topic: Topic, msg: Any) -> None:
         self.peer.publish(topic.name, serialize_ros1(msg, topic.typename, seq=topic.published))
         self.sent += 1
+        if topic.name in _PARAM_TOPICS:
+            self._mirror_param(topic.name, msg)
+
+    def _mirror_param(self, name: str, msg: Any) -> None:
+        """``/robot_description`` is a parameter in ROS 1 (robot_state_publisher and rviz
+        read it there), a latched topic in roverlab: set the parameter too."""
+        text = getattr(msg, "data", None)
+        if not isinstance(text, str):
+            return
+
+        def put() -> None:
+            try:
+                call(self.master_uri, "setParam", "/roverlab", name, text, timeout_s=10.0)
+            except MasterError as err:
+                _log.warning("could not set %s on %s: %s", name, self.master_uri, err)
+
+        threading.Thread(target=put, daemon=True, name="ros1-param").start()
 
     def on_subscription(self, sub: Subscription, added: bool) -> None:
         topic = sub.topic
@@ -173,6 +229,79 @@ class Ros1Transport:
         self.received += 1
         for sub in topic.subscriptions:
             sub._enqueue(msg)
+
+    # ----------------------------------------------------------------- services
+    def on_service(self, service: Service, added: bool) -> None:
+        fq = service.node.get_fully_qualified_name()
+        if added:
+            spec = service_spec(service.srv_type)
+            self.peer.advertise_service(fq, service.srv_name, spec, partial(self._serve, service))
+        else:
+            self.peer.unadvertise_service(fq, service.srv_name)
+
+    def _serve(self, service: Service, data: bytes) -> tuple[bool, bytes]:
+        """A ROS 1 client's call (a connection thread): served on the executor thread,
+        as every callback; the answer goes back from here."""
+        ctx = self._context
+        if ctx is None:
+            return False, f"service '{service.srv_name}' is shutting down".encode()
+        try:
+            request = deserialize_ros1(data, service.srv_type.Request.typename)
+        except Exception as err:
+            return (
+                False,
+                f"service '{service.srv_name}': a request that will not decode: {err}".encode(),
+            )
+        done = threading.Event()
+        answer: list[tuple[bool, bytes]] = []
+
+        def serve() -> None:
+            try:
+                response = service.serve(request)
+                answer.append((True, serialize_ros1(response, service.srv_type.Response.typename)))
+            except Exception as err:  # the callback's error: the caller gets its text
+                answer.append((False, str(err).encode()))
+            finally:
+                done.set()
+
+        ctx.executor.call_soon_threadsafe(serve)
+        if not done.wait(CALL_TIMEOUT_S):
+            return (
+                False,
+                f"service '{service.srv_name}' did not answer within {CALL_TIMEOUT_S:g} s".encode(),
+            )
+        return answer[0]
+
+    def on_client(self, client: Client, added: bool) -> None:
+        pass  # ROS 1 does not register service clients with the master
+
+    def service_available(self, name: str) -> bool:
+        return self.peer.lookup_service(name) is not None
+
+    def call_service(self, client: Client, request: Any, future: Future) -> bool:
+        name = client.srv_name
+        if self.peer.lookup_service(name) is None:
+            return False
+        node = client.node.get_fully_qualified_name()
+        spec = service_spec(client.srv_type)
+        response_type = client.srv_type.Response.typename
+        data = serialize_ros1(request, client.srv_type.Request.typename)
+
+        def run() -> None:
+            try:
+                raw = self.peer.call_service(node, name, spec, data, CALL_TIMEOUT_S)
+                future.set_result(deserialize_ros1(raw, response_type))
+            except ServiceCallError as err:
+                future.set_exception(ServiceError(f"service '{name}': {err}"))
+            except Exception as err:  # an answer that is not a response of this type
+                future.set_exception(
+                    ServiceError(
+                        f"service '{name}': an answer that is not a {response_type}: {err}"
+                    )
+                )
+
+        threading.Thread(target=run, daemon=True, name=f"ros1-call{name}").start()
+        return True
 
     def close(self) -> None:
         self.peer.close()
