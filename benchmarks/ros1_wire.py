@@ -107,7 +107,7 @@ def flood_roverlab_to_rospy(ctx: Context, n: int) -> dict[str, Any]:
     counter = rospy("count", "/flood_b", str(n))
     wait_ready(counter)
     node = ctx.create_node("bench_flood")
-    pub = node.create_publisher(LaserScan, "/flood_b", 10)
+    pub = node.create_publisher(LaserScan, "/flood_b", n)  # queue n: no drops, as rospy's
     transport = ctx.transports[0]
     assert isinstance(transport, Ros1Transport)
     end = time.monotonic() + 30
