@@ -9,7 +9,40 @@ from typing import Annotated, Any
 import typer
 
 from roverlab.core.errors import TransportError
+from roverlab.core.transport.ros1.errors import MasterError
 from roverlab.core.transport.ros1.master import DEFAULT_MASTER_PORT, Master
+from roverlab.core.transport.ros1.transport import ros_master_uri
+from roverlab.core.transport.ros1.xmlrpc import call, split_uri
+
+_LOCAL = {"127.0.0.1", "localhost", "::1"}
+
+
+def ensure_master() -> Master | None:
+    """As roslaunch does: with ROS_MASTER_URI naming this machine and no master answering
+    there, start one (in this process; the caller stops it). None when ROS 1 is not asked
+    for, or a master already answers.
+
+    Raises:
+        TransportError: the master's port is taken by something that is not a master.
+    """
+    uri = ros_master_uri()
+    if uri is None:
+        return None
+    try:
+        call(uri, "getUri", "/roverlab_launch", timeout_s=2.0)
+        return None
+    except MasterError:
+        pass
+    host, port = split_uri(uri)
+    if host not in _LOCAL:
+        return None  # another machine's master: the transport says it is not there
+    try:
+        master = Master(host=host if host != "localhost" else "127.0.0.1", port=port)
+    except OSError as err:
+        raise TransportError(f"cannot start a ROS master at {uri}: {err.strerror or err}") from None
+    master.start()
+    typer.echo(f"note: started a ROS master at {uri} (nothing answered there)", err=True)
+    return master
 
 
 def roscore(

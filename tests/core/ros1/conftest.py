@@ -19,6 +19,7 @@ from roverlab.core.transport.ros1.errors import MasterError
 from roverlab.core.transport.ros1.xmlrpc import call
 
 SCRIPTS = Path(__file__).parent / "scripts"
+DATA = Path(__file__).parent / "data"
 HAVE_ROS1 = Path("/usr/bin/roscore").exists()
 needs_ros1 = pytest.mark.skipif(
     not HAVE_ROS1, reason="Debian's ROS 1 (/usr/bin/roscore) is not installed"

@@ -3,8 +3,11 @@ the slave API (requestTopic, publisherUpdate, getBusInfo, getPid) and TCPROS bot
 
 from __future__ import annotations
 
+import logging
 import struct
 import time
+
+import pytest
 
 from roverlab.core.transport.ros1.peer import Ros1Peer, TopicSpec
 from tests.core.ros1.conftest import SCRIPTS, run_ros, start_ros, stop
@@ -17,7 +20,9 @@ def _string(text: str) -> bytes:
     return struct.pack("<I", len(raw)) + raw
 
 
-def test_peer_talks_tcpros_with_rospy_both_ways(real_master: str) -> None:
+def test_peer_talks_tcpros_with_rospy_both_ways(
+    real_master: str, caplog: pytest.LogCaptureFixture
+) -> None:
     peer = Ros1Peer(real_master)
     talker = start_ros(real_master, "/usr/bin/python3", str(SCRIPTS / "talker.py"), "/peer_in")
     try:
@@ -41,6 +46,22 @@ def test_peer_talks_tcpros_with_rospy_both_ways(real_master: str) -> None:
         while len(got) < 3 and time.monotonic() < end:
             time.sleep(0.05)
         assert len(got) >= 3 and got[-1][4:].startswith(b"hello ")
+        # the wrong type: refused by rospy's publisher, one line naming both sides
+        twist = TopicSpec("geometry_msgs/Twist", "9f195f881246fdfa2798d1d3eebca84a")
+        with caplog.at_level(logging.WARNING, logger="roverlab.ros1"):
+            peer.subscribe("/rl_wrong", "/peer_in2", twist, got.append)
+            talker2 = start_ros(
+                real_master, "/usr/bin/python3", str(SCRIPTS / "talker.py"), "/peer_in2"
+            )
+            end = time.monotonic() + 20
+            while not caplog.records and time.monotonic() < end:
+                time.sleep(0.05)
+            time.sleep(1.0)  # reconnection attempts meanwhile: no second line
+            stop(talker2)
+        lines = [r.getMessage() for r in caplog.records]
+        assert len(lines) == 1, lines
+        assert "geometry_msgs/Twist/9f195f881246fdfa2798d1d3eebca84a" in lines[0]
+        assert "[std_msgs/String]" in lines[0]  # rospy's publisher names its type only
         info = run_ros(real_master, "/usr/bin/rosnode", "info", "/rl_listener")
         assert "/peer_in [std_msgs/String]" in info.stdout and "Pid:" in info.stdout
         assert "Connections:" in info.stdout

@@ -14,7 +14,15 @@ from roverlab.core.qos import QoSProfile
 from roverlab.core.transport.ros1.transport import Ros1Transport
 from roverlab.msgs import classes as mc
 from roverlab.msgs import get_service_type
-from tests.core.ros1.conftest import SCRIPTS, run_ros, start_ros, stop
+from tests.core.ros1.conftest import (
+    DATA,
+    SCRIPTS,
+    needs_ros1,
+    run_ros,
+    start_ros,
+    stop,
+    wait_master,
+)
 
 
 def test_roverlab_nodes_are_ros1_nodes(real_master: str) -> None:
@@ -153,3 +161,27 @@ def test_services_both_ways_with_rospy_and_rosservice(real_master: str) -> None:
     finally:
         stop(server)
         transport.close()
+
+
+@needs_ros1
+def test_launch_starts_a_master_and_puts_its_parameters_there() -> None:
+    uri = "http://127.0.0.1:11544/"  # nothing listens here: the launch starts a master
+    env = {**os.environ, "ROS_MASTER_URI": uri, "ROS_HOSTNAME": "127.0.0.1"}
+    launch_file = str(DATA / "map_server.launch")
+    launch = subprocess.Popen(
+        [sys.executable, "-m", "roverlab.cli", "launch", launch_file, "--clock", "wall"],
+        env=env,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        wait_master(uri, 60.0)
+        greeting = run_ros(uri, "/usr/bin/rosparam", "get", "/greeting")
+        assert greeting.stdout.strip() == "hello from a launch"
+        grid = run_ros(uri, "/usr/bin/rostopic", "echo", "-n", "1", "--noarr", "/map")
+        assert "width: 216" in grid.stdout and "height: 176" in grid.stdout
+    finally:
+        stop(launch)
+    assert launch.stderr is not None
+    assert f"note: started a ROS master at {uri} (nothing answered there)" in launch.stderr.read()

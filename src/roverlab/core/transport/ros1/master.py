@@ -109,6 +109,7 @@ class Master:
         self.shutdown_requested = threading.Event()
         for name in _API_METHODS:
             self.server.add(name, getattr(self, name))
+        self.server.register_multicall_functions()  # roslaunch uploads parameters so
         self.params.set("/run_id", str(uuid.uuid1()))
         self._thread: threading.Thread | None = None
 

@@ -105,6 +105,7 @@ class Ros1Peer:
         self.pubs: dict[str, _Pub] = {}
         self.subs: dict[str, _Sub] = {}
         self.services: dict[str, _Srv] = {}
+        self._told: set[tuple[str, str, str]] = set()  # link errors already logged
         self.tcpros = TcprosServer(self.bind, self._route, self.host)
         self.on_shutdown: Callable[[str, str], None] | None = None
         self.on_param: Callable[[str, str, Any], None] | None = None
@@ -423,7 +424,11 @@ class Ros1Peer:
             if error is not None:
                 # a publisher that closes between messages has usually gone (the master
                 # will say so); anything else is worth a line
-                level = logging.DEBUG if error == "connection closed" else logging.WARNING
+                # worth a line, once per publisher and reason (a refused type would
+                # otherwise repeat at every reconnection)
+                quiet = error == "connection closed" or (topic, uri, error) in self._told
+                self._told.add((topic, uri, error))
+                level = logging.DEBUG if quiet else logging.WARNING
                 _log.log(level, "link to %s on %s ended: %s", uri, topic, error)
                 self._retry(topic, uri, callerid, backoff_s)
 

@@ -207,7 +207,11 @@ class InboundLink:
             write_header(sock, self.header)
             peer = read_header(sock)
             if "error" in peer:
-                raise HeaderError(f"publisher refused the connection: {peer['error']}")
+                ours = f"{self.header.get('type')}/{self.header.get('md5sum')}"
+                raise HeaderError(
+                    f"publisher refused the connection: {peer['error']} "
+                    f"(this node subscribes with [{ours}])"
+                )
             self._check(peer)
             self.peer_header = peer
             sock.settimeout(None)

@@ -230,6 +230,18 @@ class Ros1Transport:
         for sub in topic.subscriptions:
             sub._enqueue(msg)
 
+    def set_params(self, params: dict[str, Any]) -> list[str]:
+        """Set global parameters on the master, as roslaunch does with a launch file's
+        ``<param>`` and ``<rosparam>`` values; the names it refused (a value XML-RPC
+        cannot carry, such as an integer over 32 bits), each with the reason."""
+        refused = []
+        for name, value in params.items():
+            try:
+                call(self.master_uri, "setParam", "/roslaunch", name, value, timeout_s=10.0)
+            except (MasterError, OverflowError, TypeError) as err:
+                refused.append(f"{name}: {err}")
+        return refused
+
     # ----------------------------------------------------------------- services
     def on_service(self, service: Service, added: bool) -> None:
         fq = service.node.get_fully_qualified_name()

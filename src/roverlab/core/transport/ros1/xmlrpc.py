@@ -60,6 +60,8 @@ def call(uri: str, method: str, *args: Any, timeout_s: float = 10.0) -> Any:
     """
     try:
         reply = getattr(proxy(uri, timeout_s), method)(*args)
+    except (OverflowError, TypeError) as err:  # an argument XML-RPC cannot carry
+        raise MasterError(f"{method}: {err}") from None
     except (OSError, http.client.HTTPException) as err:
         raise MasterError(f"cannot reach {uri} ({method}): {err}") from None
     except xmlrpc.client.Fault as err:
