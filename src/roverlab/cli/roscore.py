@@ -11,8 +11,10 @@ import typer
 from roverlab.core.errors import TransportError
 from roverlab.core.transport.ros1.errors import MasterError
 from roverlab.core.transport.ros1.master import DEFAULT_MASTER_PORT, Master
+from roverlab.core.transport.ros1.peer import Ros1Peer, TopicSpec
 from roverlab.core.transport.ros1.transport import ros_master_uri
 from roverlab.core.transport.ros1.xmlrpc import call, split_uri
+from roverlab.msgs.ros1 import ros1_definition
 
 _LOCAL = {"127.0.0.1", "localhost", "::1"}
 
@@ -45,6 +47,18 @@ def ensure_master() -> Master | None:
     return master
 
 
+def start_rosout(master_uri: str) -> Ros1Peer:
+    """roscore's ``/rosout`` node: every node's log messages (``/rosout``) gathered on
+    ``/rosout_agg``, relayed as the bytes came (rqt_console and ``rostopic echo
+    /rosout_agg`` read them)."""
+    definition, md5 = ros1_definition("rosgraph_msgs/msg/Log")
+    spec = TopicSpec("rosgraph_msgs/Log", md5, definition)
+    peer = Ros1Peer(master_uri)
+    peer.advertise("/rosout", "/rosout_agg", spec, queue_size=1000)
+    peer.subscribe("/rosout", "/rosout", spec, lambda data: peer.publish("/rosout_agg", data))
+    return peer
+
+
 def roscore(
     port: Annotated[
         int,
@@ -63,9 +77,8 @@ def roscore(
     and services, lookupNode, getSystemState, ...) and the parameter server (with
     /run_id and paramUpdate callbacks), like ros_comm's roscore / rosmaster. Real rospy
     and roscpp nodes, rostopic, rosnode, rosparam and rosservice work against it; point
-    them (and roverlab) at it with ROS_MASTER_URI=http://127.0.0.1:PORT/.
-
-    Unlike roscore it starts no /rosout node and no launch file."""
+    them (and roverlab) at it with ROS_MASTER_URI=http://127.0.0.1:PORT/. As roscore, it
+    runs the /rosout node (/rosout gathered on /rosout_agg; no log file)."""
     try:
         master = Master(host=host, port=port)
     except OSError as err:
@@ -81,9 +94,11 @@ def roscore(
     signal.signal(signal.SIGINT, on_signal)
     signal.signal(signal.SIGTERM, on_signal)
     master.start()
+    rosout = start_rosout(master.uri)
     typer.echo(f"started roscore: ROS_MASTER_URI={master.uri}", err=False)
     while not stop.wait(0.2):
         if master.shutdown_requested.is_set():
             break
+    rosout.close()
     master.stop()
     typer.echo("roscore stopped")

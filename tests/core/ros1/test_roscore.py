@@ -1,5 +1,6 @@
 """``roverlab roscore`` against Debian's real ROS 1: rospy talker/listener, rosparam,
-rostopic and rosnode work against it unchanged; paramUpdate reaches a subscribed node."""
+rostopic and rosnode work against it unchanged; /rosout gathers on /rosout_agg; paramUpdate
+reaches a subscribed node."""
 
 from __future__ import annotations
 
@@ -33,6 +34,8 @@ def test_real_ros_tools_and_rospy_nodes_against_roverlab_roscore(roverlab_master
             n.startswith("/talker_")
             for n in run_ros(uri, "/usr/bin/rosnode", "list").stdout.split()
         )
+        agg = run_ros(uri, "/usr/bin/rostopic", "echo", "-n", "1", "/rosout_agg")
+        assert 'msg: "talker said hello' in agg.stdout  # roscore's /rosout node
     finally:
         stop(talker)
 

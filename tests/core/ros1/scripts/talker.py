@@ -12,5 +12,7 @@ rate = rospy.Rate(20)
 n = 0
 while not rospy.is_shutdown():
     pub.publish(String(data=f"hello {n}"))
+    if n % 10 == 0:
+        rospy.loginfo("talker said hello %d", n)
     n += 1
     rate.sleep()
