@@ -355,11 +355,23 @@ class StartGuard:
             self.context.shutdown()
 
 
-def connect_following_clock(options: NetworkOptions, clock: str) -> tuple[ZenohTransport, str, str]:
+def connect_following_clock(
+    options: NetworkOptions, clock: str
+) -> tuple[ZenohTransport | Ros1Transport, str, str]:
     """The transport, and the clock mode (``auto``: follow /clock when someone publishes
-    it, as a ROS node with /use_sim_time does next to a simulator; else wall time)."""
+    it, as a ROS node with /use_sim_time does next to a simulator; else wall time). With
+    ``ROS_MASTER_URI`` the transport is ROS 1 and ``auto`` is rospy's rule: sim time when
+    the master's ``/use_sim_time`` is true."""
     if clock not in FOLLOWER_CLOCKS:
         raise TransportError(f"unknown --clock {clock!r} ({', '.join(FOLLOWER_CLOCKS)})")
+    master = ros_master_uri()
+    if master is not None:
+        ros1 = Ros1Transport(master)
+        if clock != "auto":
+            return ros1, clock, ""
+        if ros1.get_param("/use_sim_time", False) is True:
+            return ros1, "external", f"following /clock ({master} has /use_sim_time true)"
+        return ros1, "wall", ""
     transport = ZenohTransport(options.zenoh_options())
     if clock != "auto":
         return transport, clock, ""

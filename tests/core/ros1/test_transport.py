@@ -185,3 +185,34 @@ def test_launch_starts_a_master_and_puts_its_parameters_there() -> None:
         stop(launch)
     assert launch.stderr is not None
     assert f"note: started a ROS master at {uri} (nothing answered there)" in launch.stderr.read()
+
+
+def test_roverlab_run_rospy_script_joins_the_ros1_graph(real_master: str) -> None:
+    """The issue's first complaint: `roverlab run listener.py` with ROS_MASTER_URI set
+    heard nothing from a real talker; and rospy.get_param/set_param reach the master."""
+    env = {**os.environ, "ROS_MASTER_URI": real_master, "ROS_HOSTNAME": "127.0.0.1"}
+    run = [sys.executable, "-m", "roverlab.cli", "run"]
+    assert run_ros(real_master, "/usr/bin/rosparam", "set", "/greeting", "hi").returncode == 0
+    talker = start_ros(real_master, "/usr/bin/python3", str(SCRIPTS / "talker.py"), "/run_in")
+    try:
+        heard = subprocess.run(
+            [*run, str(SCRIPTS / "listener.py"), "/run_in", "3"],
+            env=env,
+            capture_output=True,
+            text=True,
+            timeout=60,
+        )
+        assert heard.returncode == 0, heard.stderr
+        assert heard.stdout.count("hello ") >= 3
+        params = subprocess.run(
+            [*run, str(SCRIPTS / "params_rw.py")],
+            env=env,
+            capture_output=True,
+            text=True,
+            timeout=60,
+        )
+        assert params.returncode == 0, params.stderr
+        assert "greeting: hi" in params.stdout
+        assert run_ros(real_master, "/usr/bin/rosparam", "get", "/answer").stdout.strip() == "42"
+    finally:
+        stop(talker)

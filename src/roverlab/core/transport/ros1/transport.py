@@ -36,6 +36,7 @@ if TYPE_CHECKING:
     from roverlab.core.node import Node, Publisher, Subscription
     from roverlab.core.services import Client, Future, Service
 
+_MISSING: Any = object()
 #: Latched topics of roverlab that ROS 1 keeps as parameters of the same name.
 _PARAM_TOPICS = frozenset({"/robot_description"})
 #: How long a ROS 1 service call may take (either way) before it fails.
@@ -229,6 +230,23 @@ class Ros1Transport:
         self.received += 1
         for sub in topic.subscriptions:
             sub._enqueue(msg)
+
+    def get_param(self, name: str, default: Any = _MISSING) -> Any:
+        """A parameter of the master's parameter server (a namespace as a dictionary).
+
+        Raises:
+            KeyError: not set there (and no ``default``).
+        """
+        try:
+            return call(self.master_uri, "getParam", "/roverlab", name, timeout_s=10.0)
+        except MasterError:
+            if default is _MISSING:
+                raise KeyError(name) from None
+            return default
+
+    def set_param(self, name: str, value: Any) -> None:
+        """Set a parameter on the master (as rospy.set_param does for a global name)."""
+        call(self.master_uri, "setParam", "/roverlab", name, value, timeout_s=10.0)
 
     def set_params(self, params: dict[str, Any]) -> list[str]:
         """Set global parameters on the master, as roslaunch does with a launch file's
