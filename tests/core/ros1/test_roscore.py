@@ -4,6 +4,7 @@ reaches a subscribed node."""
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 import threading
@@ -87,3 +88,33 @@ def test_master_api_and_param_updates_one_per_node() -> None:
         node.shutdown()
         node.server_close()
         master.stop()
+
+
+@needs_ros1
+def test_roverlab_param_and_real_rosparam_share_the_parameter_server(
+    roverlab_master: str,
+) -> None:
+    uri = roverlab_master
+    env = {**os.environ, "ROS_MASTER_URI": uri}
+    param = [sys.executable, "-m", "roverlab.cli", "param"]
+    assert (
+        run_ros(uri, "/usr/bin/rosparam", "set", "/amcl", "{laser: {max_beams: 30}}").returncode
+        == 0
+    )
+    got = subprocess.run(
+        [*param, "get", "/amcl", "laser.max_beams"],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert got.returncode == 0 and got.stdout.strip() == "30", got.stderr
+    done = subprocess.run(
+        [*param, "set", "/amcl", "min_particles", "200"],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert done.returncode == 0, done.stderr
+    assert run_ros(uri, "/usr/bin/rosparam", "get", "/amcl/min_particles").stdout.strip() == "200"
