@@ -133,17 +133,32 @@ class NetworkOptions:
         return opts
 
 
+def _sigterm_interrupts() -> Any:
+    """SIGTERM raises KeyboardInterrupt (as Ctrl-C), so a command killed by ``kill`` or
+    ``timeout`` still leaves its ``with`` block and unregisters from a ROS 1 master (a
+    rospy node does so too); the old handler, or None off the main thread."""
+    if threading.current_thread() is not threading.main_thread():
+        return None
+
+    def interrupt(*_: Any) -> None:
+        raise KeyboardInterrupt
+
+    return signal.signal(signal.SIGTERM, interrupt)
+
+
 class Connection:
     """A wall-clock context joined to the network, for one CLI command."""
 
     def __init__(self, options: NetworkOptions, *, clock: str = "wall") -> None:
         self.context = Context(clock=clock, publish_clock=False)
         self.ros1: Ros1Transport | None = None
+        self._old_sigterm: Any = None
         self._zenoh: ZenohTransport | None = None
         master = ros_master_uri()
         if master is not None:  # ROS_MASTER_URI: the command is a ROS 1 node
             self.ros1 = Ros1Transport(master)
             self.context.add_transport(self.ros1)
+            self._old_sigterm = _sigterm_interrupts()
             return
         self._zenoh = ZenohTransport(options.zenoh_options())
         self.context.add_transport(self._zenoh)
@@ -188,7 +203,9 @@ class Connection:
             time.sleep(0.1)
 
     def close(self) -> None:
-        self.context.shutdown()
+        self.context.shutdown()  # a ROS 1 node unregisters from the master here
+        if self._old_sigterm is not None:
+            signal.signal(signal.SIGTERM, self._old_sigterm)
 
     def __enter__(self) -> Connection:
         return self

@@ -84,6 +84,9 @@ def test_roverlab_topic_echo_and_pub_with_rospy(real_master: str) -> None:
         assert echo.stdout.count('data: "hello') + echo.stdout.count("data: hello") == 2
         assert listener.wait(30) == 0
         assert listener.stdout is not None and "from the cli" in listener.stdout.read()
+        stop(pub)  # SIGTERM: the command unregisters on its way out, as a rospy node
+        nodes = run_ros(real_master, "/usr/bin/rosnode", "list").stdout.split()
+        assert "/roverlab_topic_pub" not in nodes and "/roverlab_topic_echo" not in nodes
     finally:
         for proc in (pub, talker, listener):
             stop(proc)
