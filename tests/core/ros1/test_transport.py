@@ -114,6 +114,15 @@ def test_real_ros1_tools_see_roverlab_sim(real_master: str) -> None:
             run_ros(real_master, "/usr/bin/rosparam", "get", "/use_sim_time").stdout.strip()
             == "true"
         )
+        # a second roverlab process reaches the simulator through the ROS 1 graph
+        tf = subprocess.run(
+            [sys.executable, "-m", "roverlab.cli", "tf", "echo", "odom", "base_link", "-n", "1"],
+            env=env,
+            capture_output=True,
+            text=True,
+            timeout=60,
+        )
+        assert tf.returncode == 0 and "- Translation: [" in tf.stdout, tf.stderr
         urdf = run_ros(real_master, "/usr/bin/rosparam", "get", "/robot_description")
         assert "<robot" in urdf.stdout  # a parameter in ROS 1, a latched topic in roverlab
     finally:
