@@ -68,6 +68,8 @@ def test_master_api_and_param_updates_one_per_node() -> None:
         return [1, "", 0]
 
     node.add("paramUpdate", param_update)
+    told_to_stop = threading.Event()
+    node.add("shutdown", lambda caller, msg="": (told_to_stop.set(), [1, "", 0])[1])
     threading.Thread(target=node.serve_forever, daemon=True).start()
     uri = master.uri
     try:
@@ -84,6 +86,12 @@ def test_master_api_and_param_updates_one_per_node() -> None:
         pubs, _, _ = call(uri, "getSystemState", "/x")
         assert ["/ns/out", ["/ns/node"]] in pubs
         assert call(uri, "hasParam", "/x", "/nothing") is False
+        # the same name registered from another URI: the old node is told to shut down
+        call(uri, "registerSubscriber", "/ns/node", "/in", "std_msgs/String", "http://127.0.0.1:9/")
+        assert told_to_stop.wait(5.0)
+        assert call(uri, "lookupNode", "/x", "/ns/node") == "http://127.0.0.1:9/"
+        pubs, _, _ = call(uri, "getSystemState", "/x")
+        assert ["/ns/out", ["/ns/node"]] not in pubs  # the old node's registrations went
     finally:
         node.shutdown()
         node.server_close()

@@ -18,6 +18,7 @@ from roverlab.core.transport.ros1.header import decode_header, encode_header
 from roverlab.core.transport.ros1.names import namespace_of, resolve_name
 from roverlab.core.transport.ros1.params import ParamTree, compute_updates
 from roverlab.core.transport.ros1.tcpros import OutboundLink, check_md5
+from roverlab.core.transport.ros1.xmlrpc import advertised_host, bind_host
 
 # a subscriber's header as rospy 1.15 encodes it (rosgraph.network.encode_ros_handshake_header)
 RO_SPY_HEADER = (
@@ -133,3 +134,16 @@ def test_parameter_tree_and_its_notifications() -> None:
     tree.delete("/robot/arm")
     with pytest.raises(KeyError):
         tree.get("/robot/arm/len")
+
+
+def test_advertised_address_follows_ros_hostname_then_ros_ip(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    monkeypatch.delenv("ROS_HOSTNAME", raising=False)
+    monkeypatch.delenv("ROS_IP", raising=False)
+    assert advertised_host() == "127.0.0.1"  # loopback unless told
+    monkeypatch.setenv("ROS_IP", "127.0.0.2")
+    assert advertised_host() == "127.0.0.2"
+    monkeypatch.setenv("ROS_HOSTNAME", "localhost")
+    assert advertised_host() == "localhost"
+    assert bind_host("localhost") == "127.0.0.1"
