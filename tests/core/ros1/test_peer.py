@@ -5,12 +5,16 @@ from __future__ import annotations
 
 import logging
 import struct
+import subprocess
+import sys
 import time
+from typing import Any
 
 import pytest
 
 from roverlab.core.transport.ros1.peer import Ros1Peer, TopicSpec
-from tests.core.ros1.conftest import SCRIPTS, run_ros, start_ros, stop
+from roverlab.core.transport.ros1.xmlrpc import call
+from tests.core.ros1.conftest import SCRIPTS, run_ros, start_ros, stop, wait_master
 
 STRING = TopicSpec("std_msgs/String", "992ce8a1687cec8c8bd883ec73ca41d1", "string data\n")
 
@@ -70,3 +74,35 @@ def test_peer_talks_tcpros_with_rospy_both_ways(
     finally:
         stop(talker)
         peer.close()
+
+
+def _roverlab_roscore(port: int) -> subprocess.Popen[bytes]:
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "roverlab.cli", "roscore", "-p", str(port)],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    wait_master(f"http://127.0.0.1:{port}/")
+    return proc
+
+
+def test_peer_registers_again_with_a_master_that_restarted() -> None:
+    uri = "http://127.0.0.1:11543/"
+    master = _roverlab_roscore(11543)
+    peer = Ros1Peer(uri)
+    try:
+        peer.advertise("/rl_pub", "/kept", STRING)
+        time.sleep(1.5)  # the peer learns the first master's pid
+        stop(master)
+        master = _roverlab_roscore(11543)  # a new master: it knows nothing of /kept
+        end = time.monotonic() + 10
+        pubs: list[Any] = []
+        while time.monotonic() < end:
+            pubs, _, _ = call(uri, "getSystemState", "/test")
+            if ["/kept", ["/rl_pub"]] in pubs:
+                break
+            time.sleep(0.1)
+        assert ["/kept", ["/rl_pub"]] in pubs
+    finally:
+        peer.close()
+        stop(master)

@@ -111,6 +111,9 @@ class Ros1Peer:
         self.on_param: Callable[[str, str, Any], None] | None = None
         self.closed = False
         self._master_down = False
+        self._master_pid: int | None = None
+        self._watch = threading.Event()
+        threading.Thread(target=self._watch_master, daemon=True, name="ros1-master").start()
 
     # ------------------------------------------------------------------ nodes
     def add_node(self, name: str) -> str:
@@ -506,10 +509,44 @@ class Ros1Peer:
         if self.on_shutdown is not None:
             self.on_shutdown(node, reason)
 
+    # ------------------------------------------------------------------ master restarts
+    def _watch_master(self, period_s: float = 1.0) -> None:
+        """A master that restarts (another pid) has forgotten this process: register its
+        nodes' publishers, subscribers and services again. Links between nodes run on
+        meanwhile; a master that is away only costs a debug line per second."""
+        while not self._watch.wait(period_s):
+            try:
+                pid = int(call(self.master_uri, "getPid", "/roverlab", timeout_s=2.0))
+            except (MasterError, TypeError, ValueError) as err:
+                _log.debug("master %s: %s", self.master_uri, err)
+                continue
+            if self._master_pid is not None and pid != self._master_pid and not self.closed:
+                _log.warning("the master at %s restarted: registering again", self.master_uri)
+                self._register_again()
+            self._master_pid = pid
+
+    def _register_again(self) -> None:
+        with self._lock:
+            pubs = [(n, t, p.spec.ros_type) for t, p in self.pubs.items() for n in p.nodes]
+            subs = [(n, t, s.spec.ros_type) for t, s in self.subs.items() for n in s.nodes]
+            srvs = [(s.node, name) for name, s in self.services.items()]
+            uris = {n: slave.uri for n, slave in self.slaves.items()}
+        try:
+            for node, topic, typ in pubs:
+                self._master("registerPublisher", node, topic, typ, uris[node])
+            for node, topic, typ in subs:
+                found = self._master("registerSubscriber", node, topic, typ, uris[node])
+                self.publisher_update(node, topic, [str(u) for u in found])
+            for node, name in srvs:
+                self._master("registerService", node, name, self.service_uri, uris[node])
+        except (MasterError, KeyError) as err:
+            _log.warning("registering again with %s failed: %s", self.master_uri, err)
+
     # ------------------------------------------------------------------ lifecycle
     def close(self) -> None:
         """Unregister everything from the master (best effort) and close all links."""
         self.closed = True
+        self._watch.set()
         for node in list(self.slaves):
             self.remove_node(node)
         self.tcpros.close()
