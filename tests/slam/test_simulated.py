@@ -16,7 +16,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from typer.testing import CliRunner
 
+from roverlab.cli import slam as slam_cli
 from roverlab.cli import slam_run
 from roverlab.cli.slam_run import run_hector
 from roverlab.geometry import SE2
@@ -157,10 +159,15 @@ def test_a_runaway_stops_with_one_warning_naming_the_jump(
     assert (res.data == 100).any()
 
 
-def test_slam_run_says_it_uses_the_odometry(tmp_path: Path) -> None:
-    sim = simulate(building("corridor", 20.0), laser=LASERS["180"], noise=NOISE_LEVELS["radish"],
-                   rng=np.random.default_rng(2), scan_rate_hz=5.0)  # fmt: skip
-    clf, _, gt = write_log(sim, tmp_path, "c20")
+def test_slam_simulate_then_slam_run_says_it_uses_the_odometry(tmp_path: Path) -> None:
+    made = CliRunner().invoke(
+        slam_cli.app,
+        ["simulate", "corridor", "--length", "20", "--laser", "180", "--noise", "radish",
+         "--seed", "2", "-o", str(tmp_path)],
+    )  # fmt: skip
+    assert made.exit_code == 0, made.output
+    clf, gt = tmp_path / "corridor_180_radish.clf", tmp_path / "corridor_180_radish.gt.tum"
+    assert clf.is_file() and gt.is_file()
     out = tmp_path / "out"
     proc = subprocess.run(
         [sys.executable, "-m", "roverlab.cli", "slam", "run", str(clf), "-o", str(out)],
@@ -170,3 +177,5 @@ def test_slam_run_says_it_uses_the_odometry(tmp_path: Path) -> None:
     assert "hector: odometry is the start estimate" in proc.stderr
     traj = read_tum(out / "trajectory.tum")
     assert _position_errors(traj, read_tum(gt)).max() < 0.3
+    bad = CliRunner().invoke(slam_cli.app, ["simulate", "castle", "-o", str(tmp_path)])
+    assert bad.exit_code != 0
