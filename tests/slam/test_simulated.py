@@ -179,3 +179,16 @@ def test_slam_simulate_then_slam_run_says_it_uses_the_odometry(tmp_path: Path) -
     assert _position_errors(traj, read_tum(gt)).max() < 0.3
     bad = CliRunner().invoke(slam_cli.app, ["simulate", "castle", "-o", str(tmp_path)])
     assert bad.exit_code != 0
+
+
+def test_the_start_estimate_follows_ros_names_and_the_log(corridor: SimulatedLog) -> None:
+    short = LaserLog(list(corridor.log)[:3], source="short")
+    assert slam_run.hector_odometry(short, {})[0]["use_odometry"] is True
+    off, note = slam_run.hector_odometry(short, {"use_tf_pose_start_estimate": False})
+    assert off["use_odometry"] is False and "as ROS's hector" in note
+    assert "use_tf_pose_start_estimate" not in off
+    assert slam_run.hector_odometry(short, {"use_odometry": False})[0]["use_odometry"] is False
+    still = [ScanRecord(r.timestamp, r.ranges, r.angle_min, r.angle_increment, r.range_min,
+                        r.range_max, SE2()) for r in short]  # fmt: skip
+    params, note = slam_run.hector_odometry(LaserLog(still, source="still"), {})
+    assert params["use_odometry"] is False and "has none" in note
