@@ -25,7 +25,7 @@ from roverlab.geometry import SE2
 from roverlab.slam.data import evaluate, load_log, read_relations, read_tum
 from roverlab.slam.data.scans import LaserLog, ScanRecord
 from roverlab.slam.data.trajectory import Trajectory
-from roverlab.slam.hector import scan_constraint
+from roverlab.slam.hector import GuardCounts, HectorParams, HectorSLAM, scan_constraint
 from roverlab.slam.simulated import (
     BUILDINGS,
     LASERS,
@@ -192,3 +192,37 @@ def test_the_start_estimate_follows_ros_names_and_the_log(corridor: SimulatedLog
                         r.range_max, SE2()) for r in short]  # fmt: skip
     params, note = slam_run.hector_odometry(LaserLog(still, source="still"), {})
     assert params["use_odometry"] is False and "has none" in note
+
+
+def test_a_match_that_jumps_or_collapses_is_not_taken() -> None:
+    """With odometry standing still: a scan from elsewhere in the hall (a glitched scan)
+    pulls the match 2 m in 0.5 s, beyond 2 m/s; a scan 0.6 m short (people round the robot)
+    lands on free space. Neither is taken nor mapped."""
+    sim = simulate(building("hall"), laser=LASERS["360"], noise=NOISE_LEVELS["none"],
+                   rng=np.random.default_rng(3), scan_rate_hz=2.0)  # fmt: skip
+    recs = list(sim.log)
+    here = recs[29]
+    for rec, kind in ((recs[200], "jumps"), (None, "collapsed")):
+        # (the collapse with the velocity check off: the match would jump as well)
+        gate = 2.0 if kind == "jumps" else 0.0
+        params = HectorParams(use_odometry=True, map_size=1024, max_linear_velocity=gate)
+        slam = HectorSLAM(params)
+        for r in recs[:30]:
+            slam.process(r.ranges, r.angles(), r.odom_pose, range_max=r.range_max,
+                         stamp=r.timestamp)  # fmt: skip
+        before, updates = slam.pose, slam.map_updates
+        # the collapse: returns 0.6 m away on the side the robot has seen free (the far
+        # side of the hall is beyond the lidar's range, so unknown), none elsewhere
+        short = np.where(here.angles() < 0.0, 0.6, here.range_max).astype(np.float32)
+        ranges = short if rec is None else rec.ranges
+        pose = slam.process(ranges, here.angles(), here.odom_pose, range_max=here.range_max,
+                            stamp=here.timestamp + 0.5)  # fmt: skip
+        assert getattr(slam.guard_counts, kind) == 1, (kind, slam.guard_counts)
+        assert math.hypot(pose.x - before.x, pose.y - before.y) < 1e-9
+        assert slam.map_updates == updates
+        # pure hector (ROS's) takes the match as it comes
+        pure = HectorSLAM(HectorParams(map_size=1024))
+        for r in recs[:30]:
+            pure.process(r.ranges, r.angles(), r.odom_pose, range_max=r.range_max)
+        pure.process(ranges, here.angles(), range_max=here.range_max)
+        assert pure.guard_counts == GuardCounts()

@@ -315,9 +315,14 @@ class HectorSLAM:
         """Check a match against the odometry prediction; return the pose and whether the
         scan may update the map (see :class:`HectorParams`' odometry guards)."""
         p = self.params
+        dt = self._scan_period(stamp)
+        if dt > 0.0 and _too_fast(self._pose, predicted, matched, dt, p):
+            self.guard_counts.jumps += 1
+            return predicted.copy(), False
         pose = matched.copy()
+        prob, k = self.grid.level_view(0), float(self.grid.inv_res[0])
         centre = (float(self.grid.centers[0, 0]), float(self.grid.centers[0, 1]))
-        values = map_values(self.grid.level_view(0), float(self.grid.inv_res[0]), centre, pose, pts)
+        values = map_values(prob, k, centre, pose, pts)
         if p.degenerate_eigen_ratio > 0.0:
             # only surfaces the map already holds fix the robot against the map
             ratio, weak = scan_constraint(pts, values > _OCCUPIED_ABOVE)
@@ -328,19 +333,7 @@ class HectorSLAM:
                 pose[0] += along * vx
                 pose[1] += along * vy
                 self.guard_counts.degenerate += 1
-        dt = self._scan_period(stamp)
-        if dt > 0.0:
-            moved = math.hypot(pose[0] - self._pose[0], pose[1] - self._pose[1])
-            odo = math.hypot(predicted[0] - self._pose[0], predicted[1] - self._pose[1])
-            turned = abs(wrap_angle(float(pose[2] - self._pose[2])))
-            odo_turn = abs(wrap_angle(float(predicted[2] - self._pose[2])))
-            too_far = p.max_linear_velocity > 0.0 and moved > max(p.max_linear_velocity * dt, odo)
-            too_fast = p.max_angular_velocity > 0.0 and turned > max(
-                p.max_angular_velocity * dt, odo_turn
-            )
-            if too_far or too_fast:
-                self.guard_counts.jumps += 1
-                return predicted.copy(), False
+                values = map_values(prob, k, centre, pose, pts)
         if p.max_free_endpoints < 1.0 and pts.shape[0]:
             share = float(np.count_nonzero(values < _FREE_BELOW)) / pts.shape[0]
             if share > p.max_free_endpoints:
@@ -515,6 +508,24 @@ def _compose(a: NDArray[np.float64], d: NDArray[np.float64]) -> NDArray[np.float
     return np.array(
         [a[0] + c * d[0] - s * d[1], a[1] + s * d[0] + c * d[1], wrap_angle(float(a[2] + d[2]))]
     )
+
+
+def _too_fast(
+    last: NDArray[np.float64],
+    predicted: NDArray[np.float64],
+    matched: NDArray[np.float64],
+    dt: float,
+    p: HectorParams,
+) -> bool:
+    """Whether the match moves the estimate faster than the robot can (and farther than
+    the odometry says it went) in ``dt`` seconds."""
+    moved = math.hypot(matched[0] - last[0], matched[1] - last[1])
+    odo = math.hypot(predicted[0] - last[0], predicted[1] - last[1])
+    turned = abs(wrap_angle(float(matched[2] - last[2])))
+    odo_turn = abs(wrap_angle(float(predicted[2] - last[2])))
+    if p.max_linear_velocity > 0.0 and moved > max(p.max_linear_velocity * dt, odo):
+        return True
+    return p.max_angular_velocity > 0.0 and turned > max(p.max_angular_velocity * dt, odo_turn)
 
 
 def _moved(last: NDArray[np.float64], pose: NDArray[np.float64], p: HectorParams) -> bool:
