@@ -5,9 +5,10 @@
 #   ROS 1 (ros_comm 1.15, Debian bookworm): the reference the interop tests hold roverlab
 #   against (a real roscore, rospy, rostopic, rosbag, actionlib, tf2_ros, ...). They are
 #   run with /usr/bin/python3, never inside the project's venv.
+#   tmux: the newcomer check (tests/newcomer) runs the README's commands in terminals.
 set -euo pipefail
 packages=(
-  chromium
+  chromium tmux
   ros-core python3-rospy python3-rostopic python3-rosservice python3-rosparam
   python3-rosnode python3-rosbag python3-actionlib python3-tf2-ros
   ros-robot-state-publisher liburdfdom-tools

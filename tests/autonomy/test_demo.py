@@ -7,6 +7,7 @@ import json
 import signal
 import sys
 import time
+import urllib.request
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -18,8 +19,14 @@ from PIL import Image
 from rosbags.highlevel import AnyReader
 
 from roverlab.bag.reader import BagReader
+from roverlab.cli.demo import _pause
+from roverlab.core import Context
+from roverlab.core.transport.daemon import daemon_running
 from roverlab.maps import load_map
+from roverlab.sim.app import Simulation
+from roverlab.viz.server import DashboardServer
 from tests.helpers.browser import CHROMIUM, CHROMIUM_ARGS
+from tests.helpers.net import free_port
 from tests.helpers.procs import Proc
 from tests.viz.test_dashboard import VIEWPORT
 
@@ -83,14 +90,23 @@ def test_headless_demo_runs_every_stage_and_leaves_its_files(headless: Headless)
     assert not list(out.glob("*.part"))
 
 
-def test_ctrl_c_ends_the_demo_with_its_report_and_a_complete_recording(tmp_path: Path) -> None:
+def test_ctrl_c_ends_the_demo_with_its_report_and_a_complete_recording(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Exposed on a daemon of its own that was not running: the demo starts it and, as
+    roslaunch stops the roscore it started, stops it when it ends."""
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    monkeypatch.setenv("ROVERLAB_DAEMON", endpoint)
     out = tmp_path / "demo"
-    proc = Proc([*DEMO, "--no-dashboard", "--rate", "2", "--out", str(out)])
+    proc = Proc([sys.executable, "-m", "roverlab.cli", "demo", "--expose", "--no-dashboard",
+                 "--rate", "2", "--out", str(out)])  # fmt: skip
     proc.wait_line(lambda s: s.startswith("[explore] ..."), timeout=120)
+    assert daemon_running(endpoint)
     time.sleep(3.0)
     proc.popen.send_signal(signal.SIGINT)
     code = _wait_exit(proc, 60)
     assert code == 1
+    assert not daemon_running(endpoint)
     report = _report(out)
     assert report["stages"]["explore"] == "interrupted"
     assert report["stages"]["patrol"] == "skipped" and not report["ok"]
@@ -104,6 +120,33 @@ def test_bad_arguments_are_one_line() -> None:
     code = _wait_exit(proc, 60)
     err = proc.stop()
     assert code == 2 and err.strip().splitlines() == ["error: --places must be >= 1, got 0"]
+    proc = Proc([*DEMO, "--no-dashboard", "--stay"])
+    code = _wait_exit(proc, 60)
+    assert code == 2 and proc.stop().strip().splitlines() == [
+        "error: --stay keeps the dashboard up: it cannot go with --no-dashboard"
+    ]
+
+
+def test_staying_pauses_everything_but_the_web_server() -> None:
+    """What --stay does after the report: the simulator, every node's timers and the
+    network stop; the dashboard still serves its last state; the process takes no CPU."""
+    ctx = Context(clock="paced", rate=3.0)
+    server = DashboardServer(ctx, "127.0.0.1", 0)
+    Simulation(context=ctx, world="maze", robot="mybot")
+    server.start()
+    try:
+        spinner = ctx.spin_in_thread()
+        time.sleep(1.0)
+        assert ctx.now().nanoseconds > 0  # the simulation runs
+        _pause(ctx, spinner, own_daemon=False)
+        assert not spinner.is_alive()
+        used = time.process_time()
+        time.sleep(3.0)
+        assert time.process_time() - used < 0.1  # nothing runs
+        with urllib.request.urlopen(server.url, timeout=10) as page:  # still served
+            assert page.status == 200
+    finally:
+        ctx.shutdown()
 
 
 playwright_sync = pytest.importorskip("playwright.sync_api", reason="playwright not installed")
@@ -118,7 +161,7 @@ FIVE_FPS = "() => { viz.redraw.maxFps = 5; }"
 def test_the_dashboard_shows_the_demo(tmp_path: Path) -> None:
     """The dashboard's URL comes first; the page shows the map being built, the robot and
     move_base's plan while it explores, the particle cloud while it patrols; the demo
-    reaches its report with every stage succeeding and keeps serving until Ctrl-C."""
+    reaches its report with every stage succeeding and ends by itself (as `make run`)."""
     if not CHROMIUM.exists():
         pytest.skip("/usr/bin/chromium is absent (run scripts/install-system-deps.sh)")
     out = tmp_path / "demo"
@@ -162,16 +205,16 @@ def test_the_dashboard_shows_the_demo(tmp_path: Path) -> None:
         page.wait_for_timeout(1500)
         page.screenshot(path=str(shots / "demo_patrolling.png"))
         try:
-            proc.wait_line(line("the robot waits in the maze"), timeout=300)
+            proc.wait_line(line("  files: "), timeout=300)
         except AssertionError as err:
             raise AssertionError(f"{err}; stdout: {''.join(seen)}") from None
         assert not errors, errors
+        code = _wait_exit(proc, 60)  # by itself: no Ctrl-C
     finally:
         browser.close()
         pw.stop()
         if proc.popen.poll() is None:
-            proc.popen.send_signal(signal.SIGINT)
-        code = _wait_exit(proc, 60)
+            proc.stop()
     report = _report(out)
     assert report["ok"], report["stages"]
     assert code == 0

@@ -226,8 +226,25 @@ def test_external_clock_follows_clock_messages_and_fires_timers() -> None:
         pub.publish(Clock(clock=Time(k * 200_000_000).to_msg()))
         ctx.executor.spin(wall_timeout_s=0.01)
     assert ctx.now() == Time(2_000_000_000)
-    # a timer due at 0.5 s fires when /clock passes it (at 0.6 s); no drift afterwards
-    assert fired == [600_000_000, 1_000_000_000, 1_600_000_000, 2_000_000_000]
+    # the timer starts at the first /clock (0.2 s), as rospy's do; due at 0.7 s, it fires
+    # when /clock passes it (at 0.8 s); no drift afterwards
+    assert fired == [800_000_000, 1_200_000_000, 1_800_000_000]
+
+
+def test_external_clock_timers_start_at_the_first_clock_message() -> None:
+    """A node that follows a simulator running for a minute already: its timers start at
+    the first /clock, not at 0 (they would all fire at once, a minute late)."""
+    ctx = Context(clock="external")
+    fired: list[int] = []
+    node = ctx.create_node("follower")
+    node.create_timer(15.0, lambda: fired.append(ctx.now().nanoseconds))
+    cancelled = node.create_timer(1.0, lambda: fired.append(-1))
+    cancelled.cancel()
+    pub = ctx.create_node("feeder").create_publisher(Clock, "/clock", 10)
+    for t_s in (60.0, 70.0, 75.0, 80.0):
+        pub.publish(Clock(clock=Time.from_seconds(t_s).to_msg()))
+        ctx.executor.spin(wall_timeout_s=0.01)
+    assert fired == [75_000_000_000]
 
 
 def test_timer_skips_periods_the_clock_jumped_over() -> None:
@@ -235,6 +252,8 @@ def test_timer_skips_periods_the_clock_jumped_over() -> None:
     fired: list[int] = []
     ctx.create_node("n").create_timer(0.1, lambda: fired.append(ctx.now().nanoseconds))
     pub = ctx.create_node("feeder").create_publisher(Clock, "/clock", 10)
+    pub.publish(Clock(clock=Time(0).to_msg()))  # the clock starts (and the timer with it)
+    ctx.executor.spin(wall_timeout_s=0.01)
     pub.publish(Clock(clock=Time(5_050_000_000).to_msg()))
     ctx.executor.spin(wall_timeout_s=0.01)
     pub.publish(Clock(clock=Time(5_100_000_000).to_msg()))
@@ -255,3 +274,26 @@ def test_clock_pauses_without_listeners_and_resumes_for_a_late_subscriber() -> N
     ctx.spin_for(1.0)
     assert 99 <= len(stamps) <= 100
     assert stamps[0] > 1_000_000_000 and stamps[-1] <= 2_000_000_000
+
+
+def test_wait_for_from_another_thread_counts_the_time_the_executor_lived() -> None:
+    """A callback holding a paced executor for 2 s of wall time does not use up a
+    sim-time timeout another thread waits with: the simulation stood still meanwhile."""
+    ctx = Context(clock="paced", rate=10.0)
+    node = ctx.create_node("busy")
+    held: list[bool] = []
+
+    def hold() -> None:
+        if not held:
+            held.append(True)
+            time.sleep(2.0)  # e.g. a costmap's first inflation on a loaded machine
+
+    node.create_timer(0.1, hold)
+    ctx.spin_in_thread()
+    try:
+        started = time.monotonic()
+        assert not ctx.wait_for(lambda: False, 5.0)  # 5 sim s = 0.5 s wall at rate 10
+        assert time.monotonic() - started >= 2.0
+        assert ctx.executor.now_ns >= 5_000_000_000
+    finally:
+        ctx.shutdown()

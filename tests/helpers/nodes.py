@@ -5,10 +5,12 @@ from __future__ import annotations
 import logging
 from typing import Any
 
+import numpy as np
+
 from roverlab.cli.main import main
 from roverlab.core import Context, QoSProfile
 
-__all__ = ["collect", "run_main"]
+__all__ = ["collect", "range_at", "run_main"]
 
 
 def collect(ctx: Context, topics: dict[str, Any]) -> dict[str, list[Any]]:
@@ -19,6 +21,13 @@ def collect(ctx: Context, topics: dict[str, Any]) -> dict[str, list[Any]]:
     for topic, typ in topics.items():
         node.create_subscription(typ, topic, got[topic].append, QoSProfile(depth=1000))
     return got
+
+
+def range_at(scan: Any, angle: float) -> float:
+    """The range of the beam of ``scan`` (a LaserScan) nearest to ``angle`` (rad)."""
+    ranges = np.asarray(scan.ranges)
+    angles = scan.angle_min + scan.angle_increment * np.arange(len(ranges))
+    return float(ranges[int(np.argmin(np.abs(np.angle(np.exp(1j * (angles - angle))))))])
 
 
 def run_main(argv: list[str]) -> int:

@@ -15,6 +15,7 @@ from roverlab.geometry import mesh as mesh_mod
 from roverlab.geometry.mesh import MeshError, load_mesh, mesh_cache_dir, mesh_outlines
 from roverlab.sim.app import Simulation
 from roverlab.world import PolylineShape, load_world, world_warnings
+from tests.helpers.nodes import range_at
 
 PKGS = Path(__file__).resolve().parents[1] / "ros1_packages"
 MODELS = PKGS / "book_worlds" / "models"
@@ -117,12 +118,8 @@ def test_lidar_sees_stl_dae_and_obj_obstacles_at_the_right_range(
         ctx.shutdown()
     assert scans
     scan = scans[-1]
-    ranges = np.asarray(scan.ranges)  # type: ignore[attr-defined]
-    angles = scan.angle_min + scan.angle_increment * np.arange(len(ranges))  # type: ignore[attr-defined]
-
-    def at(angle: float) -> float:
-        return float(ranges[int(np.argmin(np.abs(np.angle(np.exp(1j * (angles - angle))))))])
-
-    assert at(0.0) == pytest.approx(2.8, abs=0.05)  # STL jersey barrier ahead
-    assert at(math.pi / 2) == pytest.approx(3.5, abs=0.05)  # Collada dumpster (cm, Y up)
-    assert at(math.pi) == pytest.approx(1.6, abs=0.05)  # OBJ cone scaled x2 (hull)
+    assert range_at(scan, 0.0) == pytest.approx(2.8, abs=0.05)  # STL jersey barrier ahead
+    assert range_at(scan, math.pi / 2) == pytest.approx(
+        3.5, abs=0.05
+    )  # Collada dumpster (cm, Y up)
+    assert range_at(scan, math.pi) == pytest.approx(1.6, abs=0.05)  # OBJ cone scaled x2 (hull)

@@ -4,11 +4,13 @@ from __future__ import annotations
 
 import contextlib
 import math
+import os
 import signal
 import threading
 import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, replace
+from pathlib import Path
 from typing import Annotated, Any
 
 import typer
@@ -18,6 +20,7 @@ from roverlab.core import Context
 from roverlab.core.errors import TransportError
 from roverlab.core.transport.daemon import ensure_daemon
 from roverlab.core.transport.interfaces import split_wildcard_listen
+from roverlab.core.transport.ros1.transport import Ros1Transport, ros1_graph, ros_master_uri
 from roverlab.core.transport.zenoh import (
     GraphEntity,
     ZenohOptions,
@@ -26,6 +29,7 @@ from roverlab.core.transport.zenoh import (
 )
 from roverlab.core.transport.zenoh_stats import query_topic_counts
 from roverlab.errors import RoverlabError
+from roverlab.packages import BUNDLED_PACKAGES_DIR
 
 __all__ = [
     "FOLLOWER_CLOCKS",
@@ -133,13 +137,35 @@ class NetworkOptions:
         return opts
 
 
+def _sigterm_interrupts() -> Any:
+    """SIGTERM raises KeyboardInterrupt (as Ctrl-C), so a command killed by ``kill`` or
+    ``timeout`` still leaves its ``with`` block and unregisters from a ROS 1 master (a
+    rospy node does so too); the old handler, or None off the main thread."""
+    if threading.current_thread() is not threading.main_thread():
+        return None
+
+    def interrupt(*_: Any) -> None:
+        raise KeyboardInterrupt
+
+    return signal.signal(signal.SIGTERM, interrupt)
+
+
 class Connection:
     """A wall-clock context joined to the network, for one CLI command."""
 
     def __init__(self, options: NetworkOptions, *, clock: str = "wall") -> None:
         self.context = Context(clock=clock, publish_clock=False)
-        self.transport = ZenohTransport(options.zenoh_options())
-        self.context.add_transport(self.transport)
+        self.ros1: Ros1Transport | None = None
+        self._old_sigterm: Any = None
+        self._zenoh: ZenohTransport | None = None
+        master = ros_master_uri()
+        if master is not None:  # ROS_MASTER_URI: the command is a ROS 1 node
+            self.ros1 = Ros1Transport(master)
+            self.context.add_transport(self.ros1)
+            self._old_sigterm = _sigterm_interrupts()
+            return
+        self._zenoh = ZenohTransport(options.zenoh_options())
+        self.context.add_transport(self._zenoh)
         # A fresh session's first graph or parameter query can come back empty until it is
         # linked to the router (or a peer) and has the network's declarations: wait for
         # the link (a loaded machine can take a second), then give the declarations a
@@ -153,10 +179,26 @@ class Connection:
         time.sleep(_SETTLE_S)
         self._fresh_until = time.monotonic() + _LINK_WAIT_S
 
+    @property
+    def transport(self) -> ZenohTransport:
+        """The Zenoh transport (commands that need Zenoh itself).
+
+        Raises:
+            TransportError: the command runs as a ROS 1 node (``ROS_MASTER_URI`` is set).
+        """
+        if self._zenoh is None:
+            raise TransportError(
+                "this command does not work over ROS 1 yet: unset ROS_MASTER_URI to use "
+                "it on roverlab's own network"
+            )
+        return self._zenoh
+
     def graph(self, timeout_s: float = 1.0) -> list[GraphEntity]:
         """Nodes, publishers and subscriptions of the other processes. Shortly after
         joining, an empty answer is asked again (the declarations may still be on their
         way), so a busy machine does not make a running system look empty."""
+        if self.ros1 is not None:
+            return ros1_graph(self.ros1.master_uri, exclude=set(self.context.nodes))
         session, domain, me = self.transport.session, self.transport.domain, self.transport.zid
         while True:
             ents = [e for e in query_graph(session, domain, timeout_s) if e.zid != me]
@@ -171,7 +213,9 @@ class Connection:
         return counts
 
     def close(self) -> None:
-        self.context.shutdown()
+        self.context.shutdown()  # a ROS 1 node unregisters from the master here
+        if self._old_sigterm is not None:
+            signal.signal(signal.SIGTERM, self._old_sigterm)
 
     def __enter__(self) -> Connection:
         return self
@@ -197,8 +241,13 @@ def report_warnings(title: str, lines: list[str], strict: bool) -> None:
 
 def report_notes(lines: list[str]) -> None:
     """Print what a file sets that roverlab reads and does not act on, ``note:`` a line
-    (not warnings: ``--strict`` does not refuse them)."""
+    (not warnings: ``--strict`` does not refuse them). A file of a bundled package is
+    named as ``PKG/path`` and one below the working folder by its relative path, so that a
+    note fits a terminal line."""
+    cwd = f"{Path.cwd()}{os.sep}"
+    bundled = f"{BUNDLED_PACKAGES_DIR}{os.sep}"
     for line in lines:
+        line = line.replace(bundled, "").replace(cwd, "")
         typer.echo(f"note: {line}", err=True)
 
 
@@ -295,7 +344,14 @@ def expose_if_asked(
     """Attach ``context`` to the network (Zenoh, the command's network options) when
     :func:`choose_expose` says so, listening on ``also_listen`` too (the endpoint a
     launch's script processes join it by)."""
-    if choose_expose(expose, pace):
+    master = ros_master_uri()
+    if master is not None and choose_expose(expose, pace):
+        # ROS_MASTER_URI (or --ros-master): the run is a ROS 1 participant instead of a
+        # Zenoh one; a launch's own script processes still join it over Zenoh
+        context.add_transport(Ros1Transport(master))
+        if also_listen:
+            context.add_transport(ZenohTransport(ZenohOptions(listen=also_listen, connect=())))
+    elif choose_expose(expose, pace):
         options = network_options(ctx)
         options = replace(options, listen=(*options.listen, *also_listen))
         context.add_transport(ZenohTransport(options.zenoh_options()))
@@ -331,11 +387,23 @@ class StartGuard:
             self.context.shutdown()
 
 
-def connect_following_clock(options: NetworkOptions, clock: str) -> tuple[ZenohTransport, str, str]:
+def connect_following_clock(
+    options: NetworkOptions, clock: str
+) -> tuple[ZenohTransport | Ros1Transport, str, str]:
     """The transport, and the clock mode (``auto``: follow /clock when someone publishes
-    it, as a ROS node with /use_sim_time does next to a simulator; else wall time)."""
+    it, as a ROS node with /use_sim_time does next to a simulator; else wall time). With
+    ``ROS_MASTER_URI`` the transport is ROS 1 and ``auto`` is rospy's rule: sim time when
+    the master's ``/use_sim_time`` is true."""
     if clock not in FOLLOWER_CLOCKS:
         raise TransportError(f"unknown --clock {clock!r} ({', '.join(FOLLOWER_CLOCKS)})")
+    master = ros_master_uri()
+    if master is not None:
+        ros1 = Ros1Transport(master)
+        if clock != "auto":
+            return ros1, clock, ""
+        if ros1.get_param("/use_sim_time", False) is True:
+            return ros1, "external", f"following /clock ({master} has /use_sim_time true)"
+        return ros1, "wall", ""
     transport = ZenohTransport(options.zenoh_options())
     if clock != "auto":
         return transport, clock, ""

@@ -9,6 +9,8 @@ import yaml
 
 from roverlab.cli.common import Connection, network_options
 from roverlab.core.errors import ParameterError
+from roverlab.core.parameters import flatten_parameters
+from roverlab.core.transport.ros1.transport import Ros1Transport
 from roverlab.core.transport.zenoh import query_parameters
 
 node_app = typer.Typer(help="Inspect nodes (rosnode / ros2 node).", no_args_is_help=True)
@@ -45,10 +47,37 @@ def node_info(
 
 def _ask(ctx: typer.Context, node: str, request: dict[str, Any]) -> dict[str, Any]:
     with Connection(network_options(ctx)) as conn:
-        answer = query_parameters(conn.transport.session, node, request, conn.transport.domain)
+        if conn.ros1 is not None:
+            answer = _ask_master(conn.ros1, node, request)
+        else:
+            answer = query_parameters(conn.transport.session, node, request, conn.transport.domain)
     if "error" in answer:
         raise ParameterError(str(answer["error"]))
     return answer
+
+
+def _ask_master(ros1: Ros1Transport, node: str, request: dict[str, Any]) -> dict[str, Any]:
+    """The same questions, asked of a ROS 1 master's parameter server: a node's
+    parameters are the names under ``/node/`` (``a.b`` is ``/node/a/b``)."""
+    fq = node if node.startswith("/") else "/" + node
+    tree = ros1.get_param(fq, {})
+    flat = flatten_parameters(tree) if isinstance(tree, dict) else {}
+    op = request.get("op")
+    if op == "list":
+        return {"names": sorted(flat)}
+    if op == "dump":
+        return {"parameters": dict(sorted(flat.items()))}
+    name = str(request.get("name"))
+    key = f"{fq}/{name.replace('.', '/')}"
+    if op == "get":
+        try:
+            return {"name": name, "value": ros1.get_param(key)}
+        except KeyError:
+            return {"error": f"parameter '{key}' is not set on {ros1.master_uri}"}
+    if op == "set":
+        ros1.set_param(key, request.get("value"))
+        return {"ok": True}
+    return {"error": f"unknown parameter operation {op!r}"}
 
 
 @param_app.command("list")

@@ -20,8 +20,11 @@ from roverlab.cli.common import (
     report_warnings,
     run_context,
 )
+from roverlab.cli.roscore import ensure_master
 from roverlab.cli.sim import parse_rate
 from roverlab.core import Context, configure_logging
+from roverlab.core.transport.ros1.master import Master
+from roverlab.core.transport.ros1.transport import Ros1Transport
 from roverlab.description import find_package
 from roverlab.launch import LaunchError, LaunchSpec, build_launch, find_launch_scripts, load_launch
 from roverlab.launch.process import launch_endpoint
@@ -68,6 +71,16 @@ def choose_clock(spec: LaunchSpec, clock: str, pace: float) -> tuple[str, str]:
         "no simulator in this launch: following /clock from another process "
         "(start `roverlab sim` elsewhere, or pass --clock wall)"
     )
+
+
+@contextlib.contextmanager
+def _stopping(master: Master | None) -> Iterator[None]:
+    """Stop the ROS master this launch started (if any) when the launch ends."""
+    try:
+        yield
+    finally:
+        if master is not None:
+            master.stop()
 
 
 @contextlib.contextmanager
@@ -159,11 +172,15 @@ def launch(
     runs_scripts = any(isinstance(found, Path) for found in scripts.values())
     context = Context(clock=mode, rate=1.0 if math.isinf(pace) else pace)
     guard = StartGuard(context)
-    with _script_endpoint(runs_scripts) as also_listen:
+    ros_master = ensure_master()  # ROS_MASTER_URI and nobody there: start one, as roslaunch
+    with _script_endpoint(runs_scripts) as also_listen, _stopping(ros_master):
         with guard:
             if record is not None:
                 guard.record(record)
             expose_if_asked(ctx, context, expose, pace, also_listen=also_listen)
+            for t in context.transports:  # a ROS 1 graph: the parameters go to its master
+                if isinstance(t, Ros1Transport):
+                    report_warnings("ROS 1 parameters", t.set_params(spec.params), strict)
             started = build_launch(spec, context=context, seed=seed, scripts=scripts)
         with guard:
             report_warnings(f"launch {path.name}", started.warnings, strict)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import importlib
+import os
 from collections.abc import Callable
 from functools import cache
 from typing import Annotated, Any
@@ -35,6 +36,8 @@ _COMMANDS: dict[str, tuple[str, str]] = {
     "param": ("roverlab.cli.graph", "param_app"),
     "tf": ("roverlab.cli.tf", "app"),
     "daemon": ("roverlab.cli.daemon", "app"),
+    "roscore": ("roverlab.cli.roscore", "roscore"),
+    "master": ("roverlab.cli.roscore", "roscore"),
     "image": ("roverlab.cli.viz", "image_app"),
     "urdf": ("roverlab.cli.description", "app"),
     "map": ("roverlab.cli.maps", "app"),
@@ -134,6 +137,14 @@ def root(
             "network only: anyone on it can read and drive the robot).",
         ),
     ] = False,
+    ros_master: Annotated[
+        str | None,
+        typer.Option(
+            "--ros-master",
+            help="Join the ROS 1 graph of this master, e.g. http://127.0.0.1:11311/ "
+            "(default: ROS_MASTER_URI when set; without either, no ROS 1).",
+        ),
+    ] = None,
     client_of: Annotated[
         str | None,
         typer.Option(
@@ -145,6 +156,8 @@ def root(
     ] = None,
 ) -> None:
     """roverlab: simulate, map, localise, navigate and inspect robots the ROS way."""
+    if ros_master:
+        os.environ["ROS_MASTER_URI"] = ros_master  # as roslaunch: child processes inherit
     ctx.obj = NetworkOptions(
         connect=tuple(connect or ()),
         listen=tuple(listen or ("tcp/127.0.0.1:0",)),

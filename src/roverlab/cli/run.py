@@ -13,7 +13,7 @@ from roverlab.cli.common import connect_following_clock, network_options, run_co
 from roverlab.core import Context, Node, configure_logging
 from roverlab.errors import RoverlabError
 from roverlab.launch.process import ScriptLookupError, find_script
-from roverlab.launch.registry import REGISTRY, LaunchState
+from roverlab.launch.registry import REGISTRY, LaunchState, rosrun_name
 from roverlab.launch.xml import NodeSpec
 from roverlab.ros1 import run_script
 from roverlab.ros1.rospy.runtime import parse_command_line
@@ -38,7 +38,7 @@ def _resolve(target: list[str]) -> tuple[Path | None, NodeSpec | None, list[str]
         spec = NodeSpec(
             pkg=pkg,
             type=type_,
-            name=cl.special.get("__name", Path(type_).stem),
+            name=cl.special.get("__name", rosrun_name(pkg, type_)),
             namespace=cl.special.get("__ns", "/"),
             args=" ".join(shlex.quote(a) for a in cl.plain),
             params=dict(cl.params),

@@ -5,6 +5,7 @@
     roverlab slam eval trajectory.tum intel.relations
     roverlab slam graph input_M3500_g2o.g2o --out optimized.g2o
     roverlab slam odometry intel.clf.bz2 --out odometry.tum
+    roverlab slam simulate corridor --laser 360 --noise radish --out sim/
 
 Mounted by the root command as ``roverlab slam``. User errors are
 :class:`~roverlab.errors.RoverlabError` subclasses, turned into one ``error:`` line and
@@ -18,6 +19,7 @@ import time
 from pathlib import Path
 from typing import Annotated
 
+import numpy as np
 import typer
 
 from roverlab.cli.apps import command_app, run_app
@@ -27,8 +29,9 @@ from roverlab.slam.data.logs import load_log
 from roverlab.slam.data.pose_solver import optimize
 from roverlab.slam.data.posegraph import chi2, read_g2o, write_g2o
 from roverlab.slam.data.trajectory import read_tum, write_tum
+from roverlab.slam.simulated import BUILDINGS, LASERS, NOISE_LEVELS, building, simulate, write_log
 
-__all__ = ["app", "eval_command", "graph_command", "main", "odometry_command"]
+__all__ = ["app", "eval_command", "graph_command", "main", "odometry_command", "simulate_command"]
 
 app = command_app(
     name="slam",
@@ -128,6 +131,44 @@ def odometry_command(
     laser_log = load_log(log)
     write_tum(out, laser_log.odometry(frame=frame))
     _print(f"wrote {len(laser_log)} poses to {out}")
+
+
+@app.command("simulate")
+def simulate_command(
+    name: Annotated[str, typer.Argument(help=f"Building: {', '.join(BUILDINGS)}.")],
+    out: Annotated[Path, typer.Option("--out", "-o", help="Folder to write into.")] = Path("."),
+    length: Annotated[
+        float | None,
+        typer.Option(
+            "--length", help="Corridor length, loop length or hall width (m); default per building."
+        ),
+    ] = None,
+    laser: Annotated[
+        str, typer.Option("--laser", help="180 (SICK-like, 30 m) or 360 (12 m lidar).")
+    ] = "360",
+    noise: Annotated[
+        str,
+        typer.Option("--noise", help=f"Odometry noise: {', '.join(NOISE_LEVELS)}."),
+    ] = "radish",
+    seed: Annotated[int, typer.Option("--seed", help="Seed of the noise draws.")] = 0,
+) -> None:
+    """Simulate a robot in a building: NAME.clf (CARMEN), NAME.relations, NAME.gt.tum.
+
+    ``roverlab slam run NAME.clf`` maps it; ``roverlab slam eval trajectory.tum
+    NAME.relations`` scores the result against the ground truth.
+    """
+    if laser not in LASERS:
+        raise LogError(f"unknown --laser {laser!r} ({', '.join(LASERS)})")
+    if noise not in NOISE_LEVELS:
+        raise LogError(f"unknown --noise {noise!r} ({', '.join(NOISE_LEVELS)})")
+    sim = simulate(
+        building(name, length),
+        laser=LASERS[laser],
+        noise=NOISE_LEVELS[noise],
+        rng=np.random.default_rng(seed),
+    )
+    paths = write_log(sim, out, f"{name}_{laser}_{noise}")
+    _print(f"{len(sim.log)} scans: wrote {', '.join(str(p) for p in paths)}")
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -40,6 +40,7 @@ METHODS = ("hector", "gmapping", "graph")
 _HECTOR_MARGIN_M = 5.0
 _HECTOR_MARGIN_SHARE = 0.15
 _HECTOR_GROW_MAX = 8192  # cells per side: 1 GB for three levels
+_HECTOR_PLAUSIBLE_MARGIN_M = 50.0  # a building is at most twice the odometry's box + this
 
 
 def run_graph(records: LaserLog, params: dict[str, object]) -> MethodResult:
@@ -91,30 +92,101 @@ def hector_auto_size(records: LaserLog, params: dict[str, object]) -> dict[str, 
     span = box + 2 * margin
     step = 2 ** max(levels - 1, 0) * 64
     cells = max(base.map_size, int(math.ceil(span / res / step)) * step)
+    # odometry that jumps (a log glitch) must not size a map past any building
+    cells = max(base.map_size, min(cells, _HECTOR_GROW_MAX))
     size_m = cells * res
     out = dict(params)
     out["map_size"] = cells
     # centre the box in the map
-    out["map_start_x"] = 0.5 - 0.5 * (lo_x + hi_x) / size_m
-    out["map_start_y"] = 0.5 - 0.5 * (lo_y + hi_y) / size_m
+    # (a map capped below the box keeps the start inside it)
+    out["map_start_x"] = min(max(0.5 - 0.5 * (lo_x + hi_x) / size_m, 0.05), 0.95)
+    out["map_start_y"] = min(max(0.5 - 0.5 * (lo_y + hi_y) / size_m, 0.05), 0.95)
     return out
 
 
+def _has_odometry(records: LaserLog) -> bool:
+    """Whether the log's odometry moves at all (a log read without odometry has the
+    identity at every scan)."""
+    odo = records.odom_poses
+    return len(records) > 1 and bool(np.ptp(odo, axis=0).max() > 1e-9)
+
+
+def hector_odometry(records: LaserLog, params: dict[str, object]) -> tuple[dict[str, object], str]:
+    """hector's start estimate offline: ROS's ``use_tf_pose_start_estimate`` (odometry from
+    TF as the start of each match) is roverlab's ``use_odometry``. Unless the user set
+    either, a log with odometry uses it; the note says which."""
+    out = dict(params)
+    tf_start = out.pop("use_tf_pose_start_estimate", None)
+    if "use_odometry" in out:
+        chosen = bool(out["use_odometry"])
+        why = "(use_odometry)"
+    elif tf_start is not None:
+        chosen = bool(tf_start)
+        why = "(use_tf_pose_start_estimate)"
+        if not chosen:
+            why += ": pure scan matching, as ROS's hector"
+    else:
+        chosen = _has_odometry(records)
+        why = (
+            "(the log has odometry; use_odometry:=false for pure scan matching)"
+            if chosen
+            else "(the log has none): pure scan matching, as ROS's hector"
+        )
+    out["use_odometry"] = chosen
+    if chosen:
+        return out, (
+            f"hector: odometry is the start estimate of each match {why}; along directions "
+            "a scan cannot fix (corridors) the odometry increment is kept"
+        )
+    return out, f"hector: no odometry {why}"
+
+
+def hector_plausible_cells(records: LaserLog, hp: HectorParams) -> int:
+    """The largest map (cells per side) a run may grow to: the map doubled until it spans
+    twice the odometry's extent plus 50 m (no drift makes a building bigger than that), at
+    most :data:`_HECTOR_GROW_MAX` (a log without odometry: that). Beyond it the estimate
+    has run away."""
+    if not _has_odometry(records):
+        return max(hp.map_size, _HECTOR_GROW_MAX)
+    extent = float(np.ptp(records.odom_poses[:, :2], axis=0).max())
+    need = (2.0 * extent + _HECTOR_PLAUSIBLE_MARGIN_M) / hp.map_resolution
+    cells = hp.map_size
+    while cells < need and 2 * cells <= _HECTOR_GROW_MAX:
+        cells *= 2
+    return cells
+
+
 def run_hector(records: LaserLog, params: dict[str, object]) -> MethodResult:
+    params, odo_note = hector_odometry(records, params)
+    use_offset = bool(params.pop("use_tf_scan_transformation", True))
     sized = hector_auto_size(records, params)
     hp = HectorParams.from_ros(sized)
-    notes = []
+    notes = [odo_note]
     if sized is not params:
         notes.append(
             f"hector map sized to the log: map_size {hp.map_size} "
             f"({hp.map_size * hp.map_resolution:.1f} m), map_start_x {hp.map_start_x:.3f}, "
             f"map_start_y {hp.map_start_y:.3f}"
         )
-    # the odometry's box can be wrong (drift, a log without odometry): grow rather than fail
-    slam = HectorSLAM(hp, grow_max_size=max(hp.map_size, _HECTOR_GROW_MAX))
-    result = slam.run_log(progress(records, "hector"))
+    if not use_offset:
+        notes.append("hector: use_tf_scan_transformation false: scans taken in the base frame")
+    # the odometry's box can be wrong (drift, a log without odometry): grow rather than
+    # fail, up to a building's plausible size; beyond it the estimate ran away
+    slam = HectorSLAM(hp, grow_max_size=hector_plausible_cells(records, hp))
+    result = slam.run_log(
+        progress(records, "hector"), use_laser_offset=use_offset, stop_on_runaway=True
+    )
     if int(slam.grid.sizes[0]) != hp.map_size:
         notes.append(f"hector map grown to {int(slam.grid.sizes[0])} cells per side")
+    g = slam.guard_counts
+    if hp.use_odometry and (g.degenerate or g.jumps or g.collapsed):
+        notes.append(
+            f"hector: {g.degenerate} degenerate matches kept the odometry along the weak "
+            f"direction, {g.jumps} matches jumping faster than the robot can move and "
+            f"{g.collapsed} collapsed matches were replaced by the odometry"
+        )
+    if slam.runaway is not None:
+        notes.append(slam.runaway.warning())
     m = result.map
     return MethodResult(m.data, m.resolution, m.origin, result.poses, result.trajectory, notes)
 

@@ -235,6 +235,11 @@ class Context:
         the executor here (in ``sim`` mode the wait costs no wall time). Called from a
         callback it would block the executor that must make ``condition`` true: that is a
         RuntimeError, not a deadlock.
+
+        From another thread the clock time that counts is the time the executor has lived
+        (in ``sim`` and ``paced`` modes): a callback that holds the executor for seconds
+        of wall time (a costmap's first inflation on a loaded machine) does not use up a
+        sim-time timeout while the simulation stands still.
         """
         ex = self.executor
         tid = ex._thread_id
@@ -243,7 +248,9 @@ class Context:
                 "a blocking wait inside a callback would stop the executor it waits for; "
                 "use a callback (done_cb, add_done_callback) instead"
             )
-        deadline = None if timeout_sec is None else ex.clock_now_ns() + round(timeout_sec * 1e9)
+        lived = ex.mode in (ClockMode.SIM, ClockMode.PACED)
+        start = ex.now_ns if lived and tid is not None else ex.clock_now_ns()
+        deadline = None if timeout_sec is None else start + round(timeout_sec * 1e9)
         if tid is None:
             self._check_nodes()
             ex.spin(until_ns=deadline, stop_when=condition)
@@ -251,7 +258,8 @@ class Context:
         while not condition():
             if self._closed or ex.stopped:
                 return False
-            if deadline is not None and ex.clock_now_ns() >= deadline:
+            now = ex.now_ns if lived else ex.clock_now_ns()
+            if deadline is not None and now >= deadline:
                 return condition()
             time.sleep(0.002)
         return True

@@ -16,7 +16,10 @@ Clock modes:
     hardware or to other processes in real time.
 ``external``
     Time follows ``/clock`` messages received from another process (``use_sim_time``);
-    timers fire as that time passes.
+    timers fire as that time passes. Until the first ``/clock`` message the time is the
+    start time and no timer runs: timers made before it start at that first time, as
+    rospy's timers and sleeps wait for the clock (a node started before the simulator, or
+    long after it, does not take the time jump for seconds without data).
 
 Messages published at time *t* are delivered at time *t*, after every event that was
 already queued for *t*: the sequence number breaks ties. Work handed in from other
@@ -90,6 +93,9 @@ class Executor:
         self._sleeping = False
         self._stopped = False
         self._pace_origin: tuple[int, int] | None = None  # (sim ns, perf_counter ns)
+        self.clock_received = mode is not ClockMode.EXTERNAL
+        """False in ``external`` mode until the first ``/clock`` message."""
+        self._on_clock_start: list[Callable[[], Any]] = []
         self._max_lag_ns = round(PACED_MAX_LAG_S * 1e9 * rate) if mode is ClockMode.PACED else _INF
         self.on_error = on_error
         self.callback_errors = 0
@@ -102,6 +108,14 @@ class Executor:
     def call_at(self, t_ns: int, fn: Callable[[], Any]) -> None:
         """Run ``fn`` when the clock reaches ``t_ns`` (not before any earlier event)."""
         heapq.heappush(self._heap, (max(t_ns, self.now_ns), next(self._seq), fn))
+
+    def when_clock_starts(self, fn: Callable[[], Any]) -> None:
+        """Call ``fn`` once the clock runs: now, or (``external`` mode) at the first
+        ``/clock`` message, on the executor's thread."""
+        if self.clock_received:
+            fn()
+        else:
+            self._on_clock_start.append(fn)
 
     def call_soon(self, fn: Callable[[], Any]) -> None:
         """Run ``fn`` at the current time, after what is already queued (executor thread)."""
@@ -165,13 +179,21 @@ class Executor:
 
     def set_external_time(self, t_ns: int) -> None:
         """Advance an ``external`` clock (called with each /clock message)."""
+        if not self.clock_received:
+            # the first /clock: the timers made before it start now
+            self.clock_received = True
+            self.now_ns = max(self.now_ns, t_ns)
+            waiting, self._on_clock_start = self._on_clock_start, []
+            for fn in waiting:
+                fn()
+            return
         if t_ns > self.now_ns:
             self.now_ns = t_ns
         elif t_ns < self.now_ns - 1_000_000_000:
             # Time jumped back by more than a second (the simulation restarted): follow
             # it, as rclpy's time jump handling does, and drop timers planned far ahead.
             self.now_ns = t_ns
-            self._heap = [(min(t, t_ns), s, f) for (t, s, f) in self._heap]
+            self._heap[:] = [(min(t, t_ns), s, f) for (t, s, f) in self._heap]
             heapq.heapify(self._heap)
 
     # ----------------------------------------------------------------- running

@@ -11,6 +11,12 @@ from pathlib import Path
 __all__ = ["NodeLogger", "configure_logging", "log_to_file"]
 
 _ROOT = "roverlab"
+#: Wall seconds during which a node's warning or error identical to one it just printed is
+#: counted instead of printed (then printed once more with the count): a condition that
+#: lasts (a missing transform, a silent sensor) is said a few times a minute, not every
+#: cycle, as ROS's ``ROS_WARN_THROTTLE`` lines are.
+REPEAT_S = 20.0
+_REPEAT_KEYS = 256
 _TO_FILE: dict[str, logging.Handler] = {}  # logger name -> its file (roslaunch output="log")
 
 
@@ -74,10 +80,24 @@ class NodeLogger:
         self._logger = logging.getLogger(_logger_name(name))
         self._stamp = stamp
         self.name = name
+        self._repeats: dict[tuple[int, str], list[float]] = {}  # -> [printed at, hidden]
 
     def _log(self, level: int, msg: str, exc: bool = False) -> None:
-        if self._logger.isEnabledFor(level):
-            self._logger.log(level, msg, extra={"ros_stamp": self._stamp()}, exc_info=exc or None)
+        if not self._logger.isEnabledFor(level):
+            return
+        if level >= logging.WARNING:
+            now = time.monotonic()
+            key = (level, msg)
+            seen = self._repeats.get(key)
+            if seen is not None and now - seen[0] < REPEAT_S:
+                seen[1] += 1
+                return
+            if seen is not None and seen[1]:
+                msg = f"{msg} (and {int(seen[1])} more times in {now - seen[0]:.0f} s)"
+            if len(self._repeats) >= _REPEAT_KEYS:
+                self._repeats = {k: v for k, v in self._repeats.items() if now - v[0] < REPEAT_S}
+            self._repeats[key] = [now, 0.0]
+        self._logger.log(level, msg, extra={"ros_stamp": self._stamp()}, exc_info=exc or None)
 
     def debug(self, msg: str) -> None:
         self._log(logging.DEBUG, msg)

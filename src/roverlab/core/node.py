@@ -225,8 +225,17 @@ class Timer:
         return self.period_ns
 
     def _start(self, t_ns: int) -> None:
+        ex = self._executor
+        if not ex.clock_received:  # following a /clock that has not come yet: start then
+            delay, generation = t_ns - ex.now_ns, self._generation
+            ex.when_clock_starts(lambda: self._start_late(generation, delay))
+            return
         self._next_ns = t_ns
-        self._executor.call_at(t_ns, _TimerFire(self).fire)
+        ex.call_at(t_ns, _TimerFire(self).fire)
+
+    def _start_late(self, generation: int, delay_ns: int) -> None:
+        if generation == self._generation and not self.cancelled:
+            self._start(self._executor.now_ns + delay_ns)
 
     def cancel(self) -> None:
         self.cancelled = True

@@ -222,6 +222,23 @@ def _hull3(points: NDArray[np.float64]) -> NDArray[np.float64]:
         return pts  # flat: keep every vertex (its 2-D hull is taken later)
 
 
+def _pieces(geom: Any) -> list[NDArray[np.float64]]:
+    """The vertices of each connected piece of one geometry (the whole geometry when it
+    has more than ``_MAX_PARTS`` pieces).
+
+    Only trimesh's own code and scipy run here: ``repair=False`` skips the hole filling
+    that ``split`` does by default (``fill_holes`` needs networkx, an optional package of
+    trimesh, and a hull does not care about holes), and ``engine="scipy"`` finds the
+    pieces with scipy's connected components, never networkx."""
+    geom.merge_vertices()  # STL repeats each vertex per triangle: join them first
+    if len(geom.faces) <= 1:
+        return [np.asarray(geom.vertices, dtype=np.float64)]
+    pieces = geom.split(only_watertight=False, repair=False, engine="scipy")
+    if not 1 <= len(pieces) <= _MAX_PARTS:
+        pieces = [geom]
+    return [np.asarray(p.vertices, dtype=np.float64) for p in pieces]
+
+
 def _process(path: Path, data: bytes) -> tuple[MeshPart, ...]:
     import trimesh
 
@@ -238,17 +255,15 @@ def _process(path: Path, data: bytes) -> tuple[MeshPart, ...]:
         if geom is None or not hasattr(geom, "faces") or len(geom.faces) == 0:
             continue
         geoms.append((geom, frame @ np.asarray(transform, dtype=np.float64)))
-    for geom, transform in geoms:
-        rgb = _colour(geom)
-        geom.merge_vertices()  # STL repeats each vertex per triangle: join them first
-        pieces = geom.split(only_watertight=False) if len(geom.faces) > 1 else [geom]
-        if not 1 <= len(pieces) <= _MAX_PARTS:
-            pieces = [geom]
-        for piece in pieces:
-            v = np.asarray(piece.vertices, dtype=np.float64)
-            v = v @ transform[:3, :3].T + transform[:3, 3]
-            if len(v):
-                parts.append(MeshPart(_hull3(v), rgb))
+    try:
+        for geom, transform in geoms:
+            rgb = _colour(geom)
+            for v in _pieces(geom):
+                v = v @ transform[:3, :3].T + transform[:3, 3]
+                if len(v):
+                    parts.append(MeshPart(_hull3(v), rgb))
+    except Exception as err:  # a library failure on this file: one line naming it
+        raise MeshError(f"{path}: cannot process mesh: {type(err).__name__}: {err}") from err
     if not parts:
         raise MeshError(f"{path}: the mesh has no triangles")
     return tuple(parts)

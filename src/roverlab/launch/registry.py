@@ -36,10 +36,31 @@ from roverlab.viz.joints import SLIDER_TOPIC
 from roverlab.viz.launcher import start_image_view, start_rviz
 from roverlab.world import BUNDLED_WORLDS, load_world
 
-__all__ = ["REGISTRY", "LaunchState", "NodeFactory", "register"]
+__all__ = ["REGISTRY", "ROS_NODE_NAMES", "LaunchState", "NodeFactory", "register", "rosrun_name"]
 
 
 REGISTRY: dict[tuple[str, str], NodeFactory] = {}
+
+#: The name a ROS 1 node gives itself (``ros::init`` / ``rospy.init_node`` in its source)
+#: where it is not its executable's: ``rosrun PKG TYPE`` without ``__name:=`` runs it under
+#: that name (``rosrun usb_cam usb_cam_node`` is ``/usb_cam``, its topics
+#: ``/usb_cam/image_raw``). A launch file's ``<node name=...>`` always wins.
+ROS_NODE_NAMES: dict[tuple[str, str], str] = {
+    ("usb_cam", "usb_cam_node"): "usb_cam",
+    ("rplidar_ros", "rplidarNode"): "rplidar_node",
+    ("arbotix_python", "arbotix_driver"): "arbotix",
+    ("ros_arduino_python", "arduino_node.py"): "arduino",
+    ("hector_mapping", "hector_mapping"): "hector_slam",
+    ("move_base", "move_base"): "move_base_node",
+    ("costmap_2d", "costmap_2d_node"): "costmap_node",
+    ("robot_state_publisher", "state_publisher"): "robot_state_publisher",
+    ("gazebo_ros", "gzserver"): "gazebo",
+}
+
+
+def rosrun_name(pkg: str, type_: str) -> str:
+    """The node name ``rosrun PKG TYPE`` gives (see :data:`ROS_NODE_NAMES`)."""
+    return ROS_NODE_NAMES.get((pkg, type_), Path(type_).stem)
 
 
 def register(pkg: str, type_: str) -> Callable[[NodeFactory], NodeFactory]:
@@ -70,11 +91,16 @@ def _description(state: LaunchState, spec: NodeSpec) -> str | None:
 class DescriptionWaiter(Node):
     """Starts a node once ``/robot_description`` arrives, for launch files that rely on a
     parameter set by another launch (ROS 1's global parameter server): in roverlab the
-    description travels on the latched ``/robot_description`` topic, as in ROS 2."""
+    description travels on the latched ``/robot_description`` topic, as in ROS 2.
+
+    It waits under the node's own name (``node list`` shows ``/robot_state_publisher``, as
+    ROS does while that node waits for its parameter) and hands the name over to the node
+    it starts."""
 
     def __init__(self, state: LaunchState, spec: NodeSpec, make: Callable[[str], Node]) -> None:
-        super().__init__(f"{spec.name}_waiting_for_robot_description", context=state.context)
+        super().__init__(spec.name, context=state.context, namespace=spec.namespace)
         self.started: Node | None = None
+        self._handing_over = False
         self._make = make
         self.get_logger().info(f"{spec.name}: waiting for /robot_description")
         self.create_subscription(
@@ -85,8 +111,14 @@ class DescriptionWaiter(Node):
         )
 
     def _on_description(self, msg: Any) -> None:
-        if self.started is None:
-            self.started = self._make(str(msg.data))
+        if self.started is None and not self._handing_over:
+            self._handing_over = True
+            text = str(msg.data)
+            self.context.executor.call_soon(lambda: self._hand_over(text))
+
+    def _hand_over(self, text: str) -> None:
+        self.destroy_node()  # frees the name for the node it stands for
+        self.started = self._make(text)
 
 
 def _with_description(make: Callable[[LaunchState, NodeSpec, str], Node]) -> NodeFactory:

@@ -22,6 +22,11 @@ __all__ = ["TfMessageFilter", "Throttle"]
 
 # seconds between two repetitions of the same warning (ROS_WARN_THROTTLE-like)
 _WARN_PERIOD_S = 10.0
+# tf2_ros MessageFilter::checkFailures: first look 15 s after the first message, warn when
+# more than 95% were dropped, then look again a minute later
+_FIRST_CHECK_S = 15.0
+_CHECK_AGAIN_S = 60.0
+_DROP_SHARE = 0.95
 
 
 class Throttle:
@@ -56,7 +61,10 @@ class TfMessageFilter:
     Waiting messages are retried whenever ``/tf`` or ``/tf_static`` brings data. A message is
     dropped when ``queue_size`` newer ones wait behind it, when its stamp is older than the
     buffer's data (it can never be transformed), or, with ``timeout_s``, when it has waited
-    that long on the node's clock; drops are counted and reported by a throttled warning.
+    that long on the node's clock. Drops are counted and reported as tf2_ros does
+    (``checkFailures``): first 15 s after the first message, then at most once a minute,
+    and only while more than 95% of the messages handled were dropped, so the few
+    messages a node drops while its TF buffer fills at start are no warning.
     ``optional_frames`` are waited for too, but only up to ``timeout_s``: then the message
     is handed on without them (hector's ``waitForTransform`` before a lookup that may fail).
 
@@ -100,7 +108,8 @@ class TfMessageFilter:
         self._timeout_ns = None if timeout_s is None else round(timeout_s * 1e9)
         self._queue: deque[tuple[Any, int]] = deque()
         self._queue_size = queue_size
-        self._throttle = Throttle(node)
+        self._next_check_ns: int | None = None
+        self._last_drop = ""
         self.dropped = 0
         self.passed = 0
         node.create_subscription(TF_MESSAGE_TYPE, TF_TOPIC, self._on_tf, 100)
@@ -118,11 +127,27 @@ class TfMessageFilter:
 
     def add(self, msg: Any) -> None:
         """Queue ``msg`` and hand on every message that can now be transformed."""
-        self._queue.append((msg, self._node.get_clock().now_ns()))
+        now = self._node.get_clock().now_ns()
+        self._queue.append((msg, now))
         self._drain()
         while len(self._queue) > self._queue_size:
             old, _ = self._queue.popleft()
             self._drop(old, "discarding message because the queue is full")
+        self._check_failures(now)
+
+    def _check_failures(self, now: int) -> None:
+        if self._next_check_ns is None:
+            self._next_check_ns = now + round(_FIRST_CHECK_S * 1e9)
+        if now < self._next_check_ns:
+            return
+        total = self.dropped + self.passed
+        if not total or self.dropped / total <= _DROP_SHARE:
+            return
+        self._next_check_ns = now + round(_CHECK_AGAIN_S * 1e9)
+        self._node.get_logger().warning(
+            f"MessageFilter [target={', '.join(self.target_frames)}]: dropped "
+            f"{100.0 * self.dropped / total:.2f}% of messages so far ({self._last_drop})"
+        )
 
     def _on_tf(self, _msg: Any) -> None:
         if self._queue:
@@ -183,10 +208,4 @@ class TfMessageFilter:
 
     def _drop(self, msg: Any, reason: str) -> None:
         self.dropped += 1
-        total = self.dropped + self.passed
-        targets = ", ".join(self.target_frames)
-        self._throttle.warning(
-            "drop",
-            f"MessageFilter [target={targets}]: dropped {100.0 * self.dropped / total:.2f}% of "
-            f"messages so far (frame {str(msg.header.frame_id)!r}: {reason})",
-        )
+        self._last_drop = f"last: frame {str(msg.header.frame_id)!r}: {reason}"

@@ -42,6 +42,7 @@ __all__ = ["Costmap2DNode", "Costmap2DROS"]
 _LATCHED = QoSProfile(depth=1, durability="transient_local")
 _UPDATE_TYPE = "map_msgs/msg/OccupancyGridUpdate"
 _SENSOR_QUEUE = 50
+_START_WARN_S = 5.0  # Costmap2DROS at start: quiet, then one line every 5 s until the pose
 
 
 class Costmap2DROS:
@@ -75,6 +76,8 @@ class Costmap2DROS:
         self.layered: LayeredCostmap = make_layered_costmap(p)
         self.footprint = p.padded_footprint()
         self._throttle = Throttle(node, 1.0)
+        self._pose_seen = False
+        self._start_warning_ns: int | None = None
         self._stopped = False
         self._last_publish_ns: int | None = None
         self._publisher = CostmapPublisherState(always_send_full_costmap=p.always_send_full_costmap)
@@ -214,10 +217,17 @@ class Costmap2DROS:
         try:
             tf, stamp = self.tf_buffer.lookup_transform(p.global_frame, p.robot_base_frame, Time())
         except TransformException as err:
-            self._throttle.warning("pose", f"{self.name}: could not get robot pose: {err}")
+            if self._pose_seen:
+                self._throttle.warning("pose", f"{self.name}: could not get robot pose: {err}")
+            else:
+                self._waiting_for_pose(str(err))
             return None
         now = self.node.get_clock().now()
         age = (now.nanoseconds - stamp.nanoseconds) / 1e9
+        if age > p.transform_tolerance and not self._pose_seen:
+            self._waiting_for_pose(f"the transform is {age:.2f} s old")
+            return None
+        self._pose_seen = True
         if age > p.transform_tolerance:
             self._throttle.warning(
                 "stale",
@@ -227,6 +237,22 @@ class Costmap2DROS:
             )
             return None
         return tf.to_se2()
+
+    def _waiting_for_pose(self, err: str) -> None:
+        """Before the first pose, as Costmap2DROS waits for its transform at start: quiet
+        for the first seconds (the TF tree fills in, and catches up, as the other nodes
+        start), then one line every few seconds."""
+        now = self.node.get_clock().now_ns()
+        if self._start_warning_ns is None:
+            self._start_warning_ns = now + round(_START_WARN_S * 1e9)
+        if now < self._start_warning_ns:
+            return
+        self._start_warning_ns = now + round(_START_WARN_S * 1e9)
+        p = self.params
+        self.node.get_logger().warning(
+            f"{self.name}: waiting for the transform from {p.robot_base_frame} to "
+            f"{p.global_frame} to become available before running the costmap: {err}"
+        )
 
     def oriented_footprint(self, pose: SE2) -> np.ndarray:
         """The padded footprint at ``pose`` (global frame)."""

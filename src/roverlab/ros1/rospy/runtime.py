@@ -23,6 +23,7 @@ from roverlab.core import Context, Node
 from roverlab.core.executor import ClockMode
 from roverlab.core.graph import resolve_name
 from roverlab.core.transport.daemon import connect_context
+from roverlab.core.transport.ros1.transport import Ros1Transport
 from roverlab.core.transport.zenoh import ZenohTransport, query_parameters
 from roverlab.ros1.rospy import rostime
 from roverlab.ros1.rospy.exceptions import ROSException, ROSInitException, ROSInterruptException
@@ -308,6 +309,12 @@ class Runtime:
         """``/node/param`` (or ``/node/group/param``) read from a running node."""
         parts = full.strip("/").split("/")
         context = self.context
+        for transport in context.transports if context is not None else []:
+            if isinstance(transport, Ros1Transport):  # a ROS 1 graph: its parameter server
+                try:
+                    return transport.get_param(full)
+                except KeyError:
+                    pass
         for cut in range(len(parts) - 1, 0, -1):
             node_name = "/" + "/".join(parts[:cut])
             pname = ".".join(parts[cut:])
@@ -338,7 +345,11 @@ class Runtime:
             self.private[key] = value
             self._mirror(key, value)
         else:
-            self.params[self.resolve(name)] = value
+            full = self.resolve(name)
+            self.params[full] = value
+            for transport in self.context.transports if self.context is not None else []:
+                if isinstance(transport, Ros1Transport):  # rospy sets it on the master
+                    transport.set_param(full, value)
 
 
 def _lookup(store: dict[str, Any], key: str, name: str) -> Any:

@@ -93,6 +93,18 @@ class HectorParams:
             pre-search that follows, in steps of one coarsest-level cell; 0 turns it off.
         scan_match_damping: (roverlab) a step that would raise the cost is retried with
             Levenberg-Marquardt damping instead of taken (False: hector takes every step).
+        degenerate_eigen_ratio: (roverlab, with odometry) a scan whose surface normals'
+            information has ``lambda_min / lambda_max`` below this cannot fix the robot
+            along the weak direction (a bare corridor): along it the odometry increment is
+            kept instead of the match (:mod:`roverlab.slam.hector.degeneracy`); 0 turns it
+            off (hector: the match is taken and stalls in corridors).
+        max_linear_velocity: (roverlab, with odometry) a match that moves the estimate
+            faster than this (m/s) since the previous scan is a jump the robot cannot make:
+            the odometry prediction is kept and the map is not updated; 0 turns it off.
+        max_angular_velocity: (roverlab, with odometry) the same for turning (rad/s).
+        max_free_endpoints: (roverlab, with odometry) a match that puts more than this share
+            of the endpoints on cells the map holds free has collapsed: the odometry
+            prediction is kept and the map is not updated; 1 turns it off.
     """
 
     map_resolution: float = 0.025
@@ -117,6 +129,10 @@ class HectorParams:
     scan_match_angle_search_step: float = 0.01
     scan_match_translation_search: float = 0.2
     scan_match_damping: bool = True
+    degenerate_eigen_ratio: float = 0.01
+    max_linear_velocity: float = 2.0
+    max_angular_velocity: float = 4.0
+    max_free_endpoints: float = 0.5
 
     def __post_init__(self) -> None:
         for f in dataclasses.fields(self):
@@ -169,6 +185,11 @@ class HectorParams:
             0.0 <= self.scan_match_translation_search <= 2.0,
             "scan_match_translation_search must be in [0, 2] m",
         )
+
+        _check(0.0 <= self.degenerate_eigen_ratio < 1.0, "degenerate_eigen_ratio must be in [0, 1)")
+        _check(self.max_linear_velocity >= 0.0, "max_linear_velocity must be >= 0")
+        _check(self.max_angular_velocity >= 0.0, "max_angular_velocity must be >= 0")
+        _check(0.0 < self.max_free_endpoints <= 1.0, "max_free_endpoints must be in (0, 1]")
 
     @classmethod
     def from_ros(cls, params: Mapping[str, Any]) -> HectorParams:

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable
+from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
@@ -30,13 +31,19 @@ from roverlab.geometry import SE2, wrap_angle
 from roverlab.maps.grid import scan_arrays
 from roverlab.slam.common import ScanLike
 from roverlab.slam.data.trajectory import Trajectory
+from roverlab.slam.hector.degeneracy import map_values, scan_constraint
 from roverlab.slam.hector.errors import HectorInputError, OutOfMapError
 from roverlab.slam.hector.grid import HectorMap, MultiResGrid
 from roverlab.slam.hector.matcher import match
 from roverlab.slam.hector.params import HectorParams
 from roverlab.slam.laser import beam_endpoints
 
-__all__ = ["HectorRun", "HectorSLAM", "ScanLike", "run_log"]
+__all__ = ["GuardCounts", "HectorRun", "HectorSLAM", "Runaway", "ScanLike", "run_log"]
+
+#: A cell the map holds free has a value below this (two free observations: 0.31).
+_FREE_BELOW = 0.35
+#: ... and an occupied one above this (one hit: 0.9).
+_OCCUPIED_ABOVE = 0.6
 
 _IDENTITY = SE2()
 
@@ -54,6 +61,53 @@ class HectorRun(NamedTuple):
     poses: NDArray[np.float64]
     map: HectorMap
     trajectory: Trajectory
+
+
+@dataclass(slots=True)
+class GuardCounts:
+    """How often the odometry guards of :meth:`HectorSLAM.process` acted.
+
+    Attributes:
+        degenerate: matches whose weak direction took the odometry increment.
+        jumps: matches rejected for moving faster than the robot can.
+        collapsed: matches rejected for putting the scan on free space.
+    """
+
+    degenerate: int = 0
+    jumps: int = 0
+    collapsed: int = 0
+
+
+class Runaway(NamedTuple):
+    """Why a batch run stopped early: the estimate left the largest plausible map.
+
+    Attributes:
+        scan: index of the first scan not processed.
+        stamp: its log time (s).
+        jump_stamp: log time (s) of the estimate's largest step between two scans before
+            it (NaN if unknown), where it most likely jumped.
+        jump_m: the size of that step (m).
+        message: the error that stopped the run.
+    """
+
+    scan: int
+    stamp: float
+    jump_stamp: float
+    jump_m: float
+    message: str
+
+    def warning(self) -> str:
+        """One line naming where the estimate jumped."""
+        where = (
+            f"it jumped by {self.jump_m:.2f} m at log time {self.jump_stamp:.3f} s; "
+            if math.isfinite(self.jump_stamp)
+            else ""
+        )
+        return (
+            f"warning: hector's estimate ran away ({self.message}); {where}mapping stopped "
+            f"at log time {self.stamp:.3f} s (scan {self.scan}): the map and trajectory "
+            f"hold the scans before it"
+        )
 
 
 class HectorSLAM:
@@ -104,6 +158,11 @@ class HectorSLAM:
         self._last_motion: NDArray[np.float64] | None = None
         self.last_hessian = np.zeros((3, 3))
         self.scans_processed = 0
+        self._last_stamp: float | None = None
+        self._period = 0.0
+        self.guard_counts = GuardCounts()
+        self.largest_jump = (0.0, math.nan)
+        self.runaway: Runaway | None = None
 
     @property
     def pose(self) -> SE2:
@@ -165,8 +224,14 @@ class HectorSLAM:
         range_min: float = 0.0,
         range_max: float = math.inf,
         laser_offset: SE2 | None = None,
+        stamp: float | None = None,
     ) -> SE2:
         """Match one scan, update the map if the robot moved enough, return the pose.
+
+        With ``use_odometry`` the match is checked (:meth:`_guard`): along a direction the
+        scan cannot fix the odometry increment is kept, and a match that jumps faster than
+        the robot can move or puts the scan on free space is replaced by the odometry
+        prediction and not mapped.
 
         Args:
             scan_ranges: (N,) ranges (m); non-finite ones are dropped.
@@ -178,6 +243,7 @@ class HectorSLAM:
             range_max: the sensor's maximum range (m); readings at or beyond are dropped.
             laser_offset: this scan's laser pose in the robot frame (default: the
                 constructor's).
+            stamp: the scan's time (s), for the velocity check; None skips it.
 
         Returns:
             The robot pose in the map frame.
@@ -198,33 +264,98 @@ class HectorSLAM:
                 "odom_pose is required with map_with_known_poses or use_odometry"
             )
 
+        accept = True
         if p.map_with_known_poses:
             assert odom is not None
             pose = odom.copy()
         else:
             pose = self._pose.copy()
-            if p.use_odometry and odom is not None and self._last_odom is not None:
+            guarded = p.use_odometry and odom is not None and self._last_odom is not None
+            if guarded:
+                assert odom is not None and self._last_odom is not None
                 pose = _compose(pose, _relative(self._last_odom, odom))
             elif p.motion_prediction == "constant_velocity" and self._last_motion is not None:
                 pose = _compose(pose, self._last_motion)
             if pts.shape[0] and self.grid.updates:
-                pose, self.last_hessian = self._match(pts, pose)
+                predicted = pose
+                pose, self.last_hessian = self._match(pts, predicted)
+                if guarded:
+                    pose, accept = self._guard(pts, predicted, pose, stamp)
         pose[2] = wrap_angle(float(pose[2]))
+        if self.scans_processed:
+            self._note_jump(pose, stamp)
         self._grow_to_hold(pose, pts)
         self._check_inside(pose)
         self._last_odom = odom
         self._last_motion = _relative(self._pose, pose)
         self._pose = pose
+        self._last_stamp = stamp
         self.scans_processed += 1
 
-        if pts.shape[0] and (
-            p.map_with_known_poses
-            or self._last_update_pose is None
-            or _moved(self._last_update_pose, pose, p)
+        if (
+            pts.shape[0]
+            and accept
+            and (
+                p.map_with_known_poses
+                or self._last_update_pose is None
+                or _moved(self._last_update_pose, pose, p)
+            )
         ):
             self.grid.update(pose, np.array([off.x, off.y]), pts)
             self._last_update_pose = pose.copy()
         return self.pose
+
+    def _guard(
+        self,
+        pts: NDArray[np.float64],
+        predicted: NDArray[np.float64],
+        matched: NDArray[np.float64],
+        stamp: float | None,
+    ) -> tuple[NDArray[np.float64], bool]:
+        """Check a match against the odometry prediction; return the pose and whether the
+        scan may update the map (see :class:`HectorParams`' odometry guards)."""
+        p = self.params
+        dt = self._scan_period(stamp)
+        if dt > 0.0 and _too_fast(self._pose, predicted, matched, dt, p):
+            self.guard_counts.jumps += 1
+            return predicted.copy(), False
+        pose = matched.copy()
+        prob, k = self.grid.level_view(0), float(self.grid.inv_res[0])
+        centre = (float(self.grid.centers[0, 0]), float(self.grid.centers[0, 1]))
+        values = map_values(prob, k, centre, pose, pts)
+        if p.degenerate_eigen_ratio > 0.0:
+            # only surfaces the map already holds fix the robot against the map
+            ratio, weak = scan_constraint(pts, values > _OCCUPIED_ABOVE)
+            if ratio < p.degenerate_eigen_ratio:
+                c, s = math.cos(pose[2]), math.sin(pose[2])
+                vx, vy = c * weak[0] - s * weak[1], s * weak[0] + c * weak[1]
+                along = (predicted[0] - pose[0]) * vx + (predicted[1] - pose[1]) * vy
+                pose[0] += along * vx
+                pose[1] += along * vy
+                self.guard_counts.degenerate += 1
+                values = map_values(prob, k, centre, pose, pts)
+        if p.max_free_endpoints < 1.0 and pts.shape[0]:
+            share = float(np.count_nonzero(values < _FREE_BELOW)) / pts.shape[0]
+            if share > p.max_free_endpoints:
+                self.guard_counts.collapsed += 1
+                return predicted.copy(), False
+        return pose, True
+
+    def _scan_period(self, stamp: float | None) -> float:
+        """The time since the previous scan, at least the usual scan period (a running
+        mean of the positive gaps: logs such as intel's write scans in bursts 1 ms apart);
+        0 when unknown (no stamps, or time went backwards)."""
+        if stamp is None or self._last_stamp is None or stamp <= self._last_stamp:
+            return 0.0
+        dt = stamp - self._last_stamp
+        self._period = dt if self._period == 0.0 else 0.9 * self._period + 0.1 * min(dt, 1.0)
+        return max(dt, self._period)
+
+    def _note_jump(self, pose: NDArray[np.float64], stamp: float | None) -> None:
+        """Remember the largest step of the estimate between two scans, and when."""
+        size = math.hypot(pose[0] - self._pose[0], pose[1] - self._pose[1])
+        if size > self.largest_jump[0]:
+            self.largest_jump = (size, math.nan if stamp is None else float(stamp))
 
     def match_scan(
         self,
@@ -269,25 +400,48 @@ class HectorSLAM:
             damped=p.scan_match_damping,
         )
 
-    def run_log(self, log: Iterable[ScanLike]) -> HectorRun:
+    def run_log(
+        self,
+        log: Iterable[ScanLike],
+        *,
+        use_laser_offset: bool = True,
+        stop_on_runaway: bool = False,
+    ) -> HectorRun:
         """Process every scan of a laser log (a ``roverlab.slam.data.LaserLog``) in order.
 
-        Each record's ``laser_offset`` places the laser on the robot; the poses returned
-        are of the robot (odometry) frame, one per scan.
+        Each record's ``laser_offset`` places the laser on the robot (hector's
+        ``use_tf_scan_transformation``; ``use_laser_offset=False``: the scan is taken in the
+        robot frame); the poses returned are of the robot (odometry) frame, one per scan.
+
+        Args:
+            log: the scans.
+            use_laser_offset: place each scan by its record's laser offset.
+            stop_on_runaway: when the estimate leaves the map (beyond ``grow_max_size``),
+                stop and return what was mapped so far, with :attr:`runaway` telling where
+                (instead of raising :class:`OutOfMapError`).
         """
         poses: list[NDArray[np.float64]] = []
         stamps: list[str] = []
-        for rec in log:
+        self.runaway = None
+        for k, rec in enumerate(log):
             ranges = np.asarray(rec.ranges)
             angles = rec.angle_min + rec.angle_increment * np.arange(ranges.size)
-            pose = self.process(
-                ranges,
-                angles,
-                rec.odom_pose,
-                range_min=float(rec.range_min),
-                range_max=float(rec.range_max),
-                laser_offset=rec.laser_offset,
-            )
+            try:
+                pose = self.process(
+                    ranges,
+                    angles,
+                    rec.odom_pose,
+                    range_min=float(rec.range_min),
+                    range_max=float(rec.range_max),
+                    laser_offset=rec.laser_offset if use_laser_offset else _IDENTITY,
+                    stamp=float(rec.timestamp),
+                )
+            except OutOfMapError as err:
+                if not stop_on_runaway:
+                    raise
+                size, when = self.largest_jump
+                self.runaway = Runaway(k, float(rec.timestamp), when, size, str(err))
+                break
             poses.append(pose.as_array())
             stamps.append(rec.timestamp_text or f"{rec.timestamp:.6f}")
         arr = np.array(poses, dtype=np.float64).reshape(-1, 3)
@@ -354,6 +508,24 @@ def _compose(a: NDArray[np.float64], d: NDArray[np.float64]) -> NDArray[np.float
     return np.array(
         [a[0] + c * d[0] - s * d[1], a[1] + s * d[0] + c * d[1], wrap_angle(float(a[2] + d[2]))]
     )
+
+
+def _too_fast(
+    last: NDArray[np.float64],
+    predicted: NDArray[np.float64],
+    matched: NDArray[np.float64],
+    dt: float,
+    p: HectorParams,
+) -> bool:
+    """Whether the match moves the estimate faster than the robot can (and farther than
+    the odometry says it went) in ``dt`` seconds."""
+    moved = math.hypot(matched[0] - last[0], matched[1] - last[1])
+    odo = math.hypot(predicted[0] - last[0], predicted[1] - last[1])
+    turned = abs(wrap_angle(float(matched[2] - last[2])))
+    odo_turn = abs(wrap_angle(float(predicted[2] - last[2])))
+    if p.max_linear_velocity > 0.0 and moved > max(p.max_linear_velocity * dt, odo):
+        return True
+    return p.max_angular_velocity > 0.0 and turned > max(p.max_angular_velocity * dt, odo_turn)
 
 
 def _moved(last: NDArray[np.float64], pose: NDArray[np.float64], p: HectorParams) -> bool:

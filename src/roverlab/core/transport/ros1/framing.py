@@ -1,0 +1,89 @@
+"""Length-prefixed TCPROS framing over a socket, bounded.
+
+Every TCPROS unit (connection header, message, service request or response) is a 4-byte
+little-endian length and that many bytes. A length is untrusted: it is checked against a
+cap, and the buffer grows only as bytes arrive, so a peer that claims 4 GB and sends
+nothing costs nothing.
+"""
+
+from __future__ import annotations
+
+import socket
+import struct
+
+from roverlab.core.transport.ros1.errors import ProtocolError
+from roverlab.core.transport.ros1.header import MAX_HEADER_BYTES, decode_header, encode_header
+
+__all__ = [
+    "MAX_MESSAGE_BYTES",
+    "PeerClosedError",
+    "frame",
+    "read_exact",
+    "read_frame",
+    "read_header",
+    "write_header",
+]
+
+MAX_MESSAGE_BYTES = 512 << 20  # 512 MiB: larger than any camera or cloud message
+_CHUNK = 1 << 20
+_U32 = struct.Struct("<I")
+
+
+class PeerClosedError(ProtocolError):
+    """The peer closed the connection (cleanly between units, or mid-unit)."""
+
+
+def read_exact(sock: socket.socket, size: int) -> bytes:
+    """Exactly ``size`` bytes; the buffer grows by at most 1 MiB per read.
+
+    Raises:
+        PeerClosedError: the connection ended first.
+    """
+    if size <= _CHUNK:
+        buf = bytearray(size)
+        view = memoryview(buf)
+        got = 0
+        while got < size:
+            n = sock.recv_into(view[got:], size - got)
+            if n == 0:
+                raise PeerClosedError(f"connection closed after {got} of {size} bytes")
+            got += n
+        return bytes(buf)
+    out = bytearray()
+    while len(out) < size:
+        part = sock.recv(min(_CHUNK, size - len(out)))
+        if not part:
+            raise PeerClosedError(f"connection closed after {len(out)} of {size} bytes")
+        out += part
+    return bytes(out)
+
+
+def read_frame(sock: socket.socket, max_bytes: int = MAX_MESSAGE_BYTES) -> bytes:
+    """One length-prefixed unit.
+
+    Raises:
+        PeerClosedError: the connection ended (before or inside the unit).
+        ProtocolError: the length is over ``max_bytes``.
+    """
+    try:
+        head = read_exact(sock, 4)
+    except PeerClosedError:
+        raise PeerClosedError("connection closed") from None
+    (size,) = _U32.unpack(head)
+    if size > max_bytes:
+        raise ProtocolError(f"length prefix {size} bytes is over the {max_bytes}-byte cap")
+    return read_exact(sock, size)
+
+
+def frame(data: bytes) -> bytes:
+    """``data`` with its 4-byte length in front."""
+    return _U32.pack(len(data)) + data
+
+
+def read_header(sock: socket.socket) -> dict[str, str]:
+    """A connection header from the socket (capped at :data:`MAX_HEADER_BYTES`)."""
+    return decode_header(read_frame(sock, MAX_HEADER_BYTES))
+
+
+def write_header(sock: socket.socket, fields: dict[str, str]) -> None:
+    sock.sendall(encode_header(fields))
