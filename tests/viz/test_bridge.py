@@ -349,4 +349,10 @@ def test_a_bag_played_again_resets_tf_when_clock_jumps_back() -> None:
     play(0.5, 0.5)  # half a second back is jitter, not a restart: nothing is dropped
     here, _ = bridge.lookup_why("base_footprint")
     assert here is not None and here.translation[0] == pytest.approx(1.0)
+    assert any(sub.topic_name == "/clock" for sub in bridge.node.subscriptions)
     ctx.shutdown()
+    # on a simulation's own clock the dashboard leaves /clock alone (it pauses unread)
+    sim = Context()
+    in_sim = VizBridge(context=sim, config=_config())
+    assert all(sub.topic_name != "/clock" for sub in in_sim.node.subscriptions)
+    sim.shutdown()

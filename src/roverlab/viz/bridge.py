@@ -183,7 +183,11 @@ class VizBridge(DisplayStatus):
         self.cmd_vel_pub = node.create_publisher("geometry_msgs/msg/Twist", "/cmd_vel", 1)
         node.create_timer(0.1, self._refresh_markers)  # lifetimes and frame-locked markers
         self._clock_ns: int | None = None
-        node.create_subscription("rosgraph_msgs/msg/Clock", "/clock", self._on_clock, 1)
+        if not context.uses_sim_time:
+            # on the wall clock (`roverlab dashboard`), watch /clock for a bag played again;
+            # on a simulation's clock the TF listener sees jumps itself, and /clock keeps
+            # pausing while nobody else reads it
+            node.create_subscription("rosgraph_msgs/msg/Clock", "/clock", self._on_clock, 1)
         self._apply(self.config)
 
     # ------------------------------------------------------------------ state
