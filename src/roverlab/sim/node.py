@@ -65,6 +65,7 @@ from roverlab.sim.dynamics import (
     compiled_entry,
 )
 from roverlab.sim.planar_move import PlanarMovePlugin
+from roverlab.sim.ros_control import DiffDriveControllerConfig, DiffDriveControllerPlugin
 from roverlab.sim.sensors import CameraModel, ImuModel, LidarModel
 from roverlab.tf import TransformBroadcaster
 
@@ -163,7 +164,10 @@ class SimulatorNode(Node):
         self.drive = robot.drive
         d = self.drive if isinstance(self.drive, DiffDriveConfig) else None
         # the node's wheel_slip parameter sets the drive's slip (DiffDriveParams validates)
-        p = replace(d.params if d else DiffDriveParams(1.0, 1.0), slip_stddev=self.wheel_slip)
+        wheels = self.drive if isinstance(self.drive, DiffDriveControllerConfig) else d
+        p = replace(
+            wheels.params if wheels else DiffDriveParams(1.0, 1.0), slip_stddev=self.wheel_slip
+        )
         self._params = np.array(
             [
                 p.wheel_separation_m,
@@ -197,6 +201,12 @@ class SimulatorNode(Node):
             self.planar_move = PlanarMovePlugin(
                 node=self, config=self.drive, state=self._state, advance=self.advance,
                 tf_publisher=self._tf_pub,
+            )  # fmt: skip
+        self.controller = None
+        if isinstance(self.drive, DiffDriveControllerConfig):  # gazebo_ros_control
+            self.controller = DiffDriveControllerPlugin(
+                node=self, config=self.drive, state=self._state, advance=self.advance,
+                tf_publisher=self._tf_pub, physics_period_s=self._dt,
             )  # fmt: skip
         if d is not None:
             self.create_subscription(mc.Twist, d.command_topic, self._on_cmd, 10)
@@ -297,6 +307,8 @@ class SimulatorNode(Node):
             st[i] = 0.0
         if self.planar_move is not None:  # its command, timeout and odometry start over
             self.planar_move.reset()
+        if self.controller is not None:
+            self.controller.reset()
 
     # ----------------------------------------------------------------- commands
     def _on_cmd(self, msg: Any) -> None:
