@@ -137,7 +137,8 @@ class MoveBase(Node):
             for k in self.unused_parameter_overrides()
             if "/" not in k and "." not in k
         }
-        self.params = p = MoveBaseParams.from_ros(top)
+        self.params, mb_warnings = MoveBaseParams.from_ros(top)
+        p = self.params
         log = self.get_logger()
         self.tf_buffer = Buffer()
         self.tf_listener = TransformListener(self.tf_buffer, self)
@@ -149,17 +150,18 @@ class MoveBase(Node):
             p.base_global_planner, parameters_under(self, gname)
         )
         lname = plugin_short_name(p.base_local_planner)
+        lvalues = parameters_under(self, lname)
         self.controller, limits, w2 = make_local_planner(
             p.base_local_planner,
-            parameters_under(self, lname),
+            lvalues,
             footprint=self.local_costmap.footprint,
             controller_frequency=p.controller_frequency,
         )
-        for w in (*warnings, *w2):
+        for w in (*mb_warnings, *warnings, *w2):
             log.warning(w)
         _inscribed, circumscribed = footprint_radii(self.global_costmap.footprint)
         tp = parameters_under(self, "TrajectoryPlannerROS")
-        self.recoveries = [
+        made = [
             make_recovery(
                 r.name,
                 r.type,
@@ -175,6 +177,10 @@ class MoveBase(Node):
             )
             for r in p.recoveries
         ]
+        self.recoveries = [rec for rec, _ in made]
+        for _, rw in made:
+            for w in rw:
+                log.warning(w)
         # parameters of the planners not in use (a launch file loads both dwa and teb files,
         # as seed 003's does): ROS keeps them on the parameter server unread; so do we
         idle = {plugin_short_name(n) for n in (*GLOBAL_PLANNERS, *LOCAL_PLANNERS)} - {gname, lname}
@@ -196,7 +202,9 @@ class MoveBase(Node):
         self._simple_goals = 0
         self.create_subscription(PoseStamped, "move_base_simple/goal", self._on_simple_goal, 1)
         self._twist = Velocity2D()
-        self.create_subscription(mc.Odometry, "odom", self._on_odom, 1)
+        # the local planner's odom_topic (base_local_planner's OdometryHelperRos)
+        odom_topic = str(lvalues.get("odom_topic", "odom"))
+        self.create_subscription(mc.Odometry, odom_topic, self._on_odom, 1)
         self.create_service("nav_msgs/GetPlan", "~/make_plan", self._on_make_plan)
         self.create_service("std_srvs/Empty", "~/clear_costmaps", self._on_clear_costmaps)
         self.create_timer(1.0 / p.controller_frequency, self._cycle)

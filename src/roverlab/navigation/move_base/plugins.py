@@ -26,6 +26,7 @@ from roverlab.navigation.move_base.recovery import (
     RotateRecovery,
     RotateRecoveryParams,
 )
+from roverlab.navigation.params import unknown_warning
 from roverlab.navigation.planners import (
     GlobalPlanner,
     GlobalPlannerParams,
@@ -113,8 +114,8 @@ def make_recovery(
     limits: LocalPlannerLimits,
     trajectory_planner: Mapping[str, Any],
     footprint: ArrayLike,
-) -> Recovery:
-    """One recovery behaviour.
+) -> tuple[Recovery, tuple[str, ...]]:
+    """One recovery behaviour, and warnings (unknown names: ROS ignores them).
 
     ``clear_costmap_recovery/ClearCostmapRecovery``: ``reset_distance`` defaults to
     ``default_reset_distance`` (move_base: ``conservative_reset_dist``, or four times the
@@ -123,14 +124,15 @@ def make_recovery(
     rotation limits from ``~TrajectoryPlannerROS/`` as ROS 1 reads them, else from the
     local planner in use (ROS falls back to fixed defaults there).
     """
+    warnings: list[str] = []
     if plugin == "clear_costmap_recovery/ClearCostmapRecovery":
-        return ClearCostmapRecovery.from_ros(
-            name, values, default_reset_distance=default_reset_distance
+        rec = ClearCostmapRecovery.from_ros(
+            name, values, default_reset_distance=default_reset_distance, warnings=warnings
         )
+        return rec, tuple(warnings)
     if plugin == "rotate_recovery/RotateRecovery":
-        unknown = sorted(set(values) - {"sim_granularity", "frequency"})
-        if unknown:
-            raise NavigationParamsError(f"{name}: unknown parameter(s) {', '.join(unknown)}")
+        known = ("sim_granularity", "frequency")
+        warnings += [unknown_warning(name, k, known) for k in sorted(set(values) - set(known))]
         tp = trajectory_planner
         get: Callable[[str, float], float] = lambda key, fallback: float(  # noqa: E731
             tp.get(key, fallback)
@@ -148,5 +150,5 @@ def make_recovery(
             )
         except (TypeError, ValueError) as err:
             raise NavigationParamsError(f"{name}: {err}") from None
-        return RotateRecovery(name, params, footprint=footprint)
+        return RotateRecovery(name, params, footprint=footprint), tuple(warnings)
     raise NavigationParamsError(f"move_base: unknown recovery behavior type {plugin!r}")
