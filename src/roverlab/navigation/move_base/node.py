@@ -62,8 +62,9 @@ from roverlab.navigation.move_base.plugins import (
     make_local_planner,
     make_recovery,
     plugin_short_name,
+    rotate_fallback,
 )
-from roverlab.navigation.move_base.recovery import ClearCostmapRecovery, RotateRecovery
+from roverlab.navigation.move_base.recovering import Recovering
 from roverlab.navigation.node_params import parameters_under
 from roverlab.navigation.planners import Path2D, path_to_msg
 from roverlab.navigation.planners.footprint_check import plan_clear_of_footprint
@@ -151,10 +152,12 @@ class MoveBase(Node):
         )
         lname = plugin_short_name(p.base_local_planner)
         lvalues = parameters_under(self, lname)
+        body = self.local_costmap.params.unpadded_footprint()
         self.controller, limits, w2 = make_local_planner(
             p.base_local_planner,
             lvalues,
             footprint=self.local_costmap.footprint,
+            body_footprint=body,
             controller_frequency=p.controller_frequency,
         )
         for w in (*mb_warnings, *warnings, *w2):
@@ -174,6 +177,7 @@ class MoveBase(Node):
                 limits=limits,
                 trajectory_planner=tp,
                 footprint=self.local_costmap.footprint,
+                body_footprint=body,
             )
             for r in p.recoveries
         ]
@@ -214,7 +218,9 @@ class MoveBase(Node):
         self.state = PLANNING
         self.recovery_trigger = PLANNING_R
         self.recovery_index = 0
-        self._recovery_running: RotateRecovery | None = None
+        self.recovering = Recovering(
+            self, rotate_fallback(limits, self.local_costmap.footprint, body)
+        )
         self._last_valid_plan = 0.0
         self._last_valid_control = 0.0
         self._last_oscillation_reset = 0.0
@@ -306,7 +312,7 @@ class MoveBase(Node):
         self.state = PLANNING
         self.recovery_index = 0
         self.recovery_trigger = PLANNING_R
-        self._recovery_running = None
+        self.recovering.running = None
         self._last_valid_plan = self._last_valid_control = now
         self._last_oscillation_reset = now
         self._oscillation_pose = None
@@ -325,7 +331,7 @@ class MoveBase(Node):
         self.state = PLANNING
         self.recovery_index = 0
         self.recovery_trigger = PLANNING_R
-        self._recovery_running = None
+        self.recovering.running = None
         self.goal = None
         self.plan = None
         self.publish_zero_velocity()
@@ -382,7 +388,7 @@ class MoveBase(Node):
         elif self.state == CONTROLLING:
             self._control_step(now)
         else:
-            self._clear_step(now)
+            self.recovering.clear_step(now)
 
     def _plan_step(self, now: float, gpose: SE2 | None) -> None:
         assert self.goal is not None
@@ -518,6 +524,7 @@ class MoveBase(Node):
         self._last_valid_control = now
         if self.recovery_trigger == CONTROLLING_R:
             self.recovery_index = 0
+        cmd = self.recovering.limited(cmd, lpose)
         self.cmd_pub.publish(Twist(linear_x=cmd.vx, linear_y=cmd.vy, angular_z=cmd.wz))
         trajectory = getattr(self.controller, "trajectory", None)
         if trajectory is not None and len(trajectory):
@@ -526,59 +533,9 @@ class MoveBase(Node):
             )
         self._publish_path(self.local_global_plan_pub, local_plan, self.local_costmap.global_frame)
 
-    def _clear_step(self, now: float) -> None:
-        running = self._recovery_running
-        if running is not None:
-            lpose = self.local_costmap.get_robot_pose()
-            speed = None if lpose is None else running.step(lpose, self.local_costmap.costmap)
-            if speed is not None:
-                self.cmd_pub.publish(Twist(angular_z=speed))
-                return
-            if running.blocked:
-                self.get_logger().error(running.blocked)
-            self.publish_zero_velocity()
-            self._recovery_done(now)
-            return
-        p = self.params
-        if not (p.recovery_behavior_enabled and self.recovery_index < len(self.recoveries)):
-            self.get_logger().error(
-                "All recovery behaviors have failed, locking the planner and disabling it."
-            )
-            self._abort(ABORT_TEXTS[self.recovery_trigger])
-            return
-        rec = self.recoveries[self.recovery_index]
-        self.get_logger().info(f"Executing recovery behavior {rec.name}")
-        if isinstance(rec, ClearCostmapRecovery):
-            cleared = rec.run(
-                global_costmap=self.global_costmap.layered,
-                global_pose=self.global_costmap.get_robot_pose(),
-                local_costmap=self.local_costmap.layered,
-                local_pose=self.local_costmap.get_robot_pose(),
-            )
-            self.get_logger().info(
-                f"{rec.name}: cleared {', '.join(cleared) or 'nothing'} outside a "
-                f"{rec.reset_distance:.2f} m square around the robot"
-            )
-            if rec.force_updating:
-                self.global_costmap.update_map()
-                self.local_costmap.update_map()
-            self._recovery_done(now)
-            return
-        lpose = self.local_costmap.get_robot_pose()
-        if lpose is None:
-            self._recovery_done(now)
-            return
-        rec.start(lpose)
-        self._recovery_running = rec
-        self._clear_step(now)
-
-    def _recovery_done(self, now: float) -> None:
-        self._recovery_running = None
-        self._last_oscillation_reset = now
-        self._last_valid_plan = now
-        self._planning_retries = 0
-        self.state = PLANNING
-        self.recovery_index += 1
+    def abort_text(self) -> str:
+        """move_base's text for an ABORT after the recoveries."""
+        return ABORT_TEXTS[self.recovery_trigger]
 
     # ------------------------------------------------------------------ services
     def _on_make_plan(self, request: Any, response: Any) -> Any:
