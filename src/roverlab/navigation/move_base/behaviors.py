@@ -71,7 +71,9 @@ class BehaviorParams:
     def __post_init__(self) -> None:
         for f in fields(self):
             v = getattr(self, f.name)
-            check(math.isfinite(v) and v >= 0, f"behavior: {f.name} must be >= 0, got {v}")
+            if f.name != "spin_dist":  # its sign is the direction
+                check(math.isfinite(v) and v >= 0, f"behavior: {f.name} must be >= 0, got {v}")
+        check(math.isfinite(self.spin_dist), "behavior: spin_dist must be a finite number")
         check(self.backup_speed > 0, "behavior: backup_speed must be > 0")
         check(self.max_rotational_vel > 0, "behavior: max_rotational_vel must be > 0")
 
