@@ -552,6 +552,8 @@ class MoveBase(Node):
             raise NavigationError(f"make_plan: {err}") from err
         if start is None:
             raise NavigationError("make_plan: the robot's pose is not known")
+        if self.params.make_plan_clear_costmap:
+            self.recovering.clear_around_robot(self._clearing_radius())
         planner: Any = self.planner
         tol = float(request.tolerance)
         if tol > 0 and hasattr(planner, "params"):  # the request's tolerance, for this plan
@@ -562,8 +564,18 @@ class MoveBase(Node):
             self.get_logger().warning(f"make_plan: {err}")
             response.plan = Path(header_frame_id=self.global_frame)
             return response
+        if self.params.make_plan_add_unreachable_goal and len(path):
+            end = np.asarray(path)[-1]
+            if math.hypot(end[0] - goal.x, end[1] - goal.y) > 1e-6:
+                # the goal itself, in case the local planner can get the robot there
+                path = np.vstack([path, goal.as_array()])
         response.plan = path_to_msg(path, self.global_frame, self.get_clock().now())
         return response
+
+    def _clearing_radius(self) -> float:
+        """move_base's ``clearing_radius`` (default: the circumscribed radius)."""
+        r = self.params.clearing_radius
+        return footprint_radii(self.global_costmap.footprint)[1] if r is None else r
 
     def _on_clear_costmaps(self, _request: Any, response: Any) -> Any:
         """``~clear_costmaps``: reset both costmaps' layers."""

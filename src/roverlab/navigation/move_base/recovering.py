@@ -132,6 +132,19 @@ class Recovering:
                 rec.engage(lpose)
                 self.speed_limit = rec
 
+    def clear_around_robot(self, radius: float) -> list[str]:
+        """move_base's ``clearCostmapWindows``: forget the obstacle layers' marks within
+        ``radius`` of the robot (a square), in both costmaps; the layers cleared."""
+        clear = ClearCostmapRecovery(
+            "make_plan", reset_distance=2.0 * radius, invert_area_to_clear=True
+        )
+        return clear.run(
+            global_costmap=self.node.global_costmap.layered,
+            global_pose=self.node.global_costmap.get_robot_pose(),
+            local_costmap=self.node.local_costmap.layered,
+            local_pose=self.node.local_costmap.get_robot_pose(),
+        )
+
     def limited(self, cmd: Velocity2D, pose: SE2) -> Velocity2D:
         """``cmd`` under a MoveSlowAndClear's cap while it holds."""
         lim = self.speed_limit
