@@ -300,6 +300,11 @@ def _parse(flat: dict[str, Any], name: str) -> tuple[CostmapParams, tuple[str, .
         if key != "track_unknown_space":
             top.pop(key)
             warnings.append(f"{name}: parameter {key} is unused (no layer of its type)")
+    if "footprint_topic" in top:
+        warnings.append(
+            f"{name}: footprint_topic is not subscribed: roverlab has no dynamic footprint "
+            "(the footprint parameter is used)"
+        )
     params, res = build_params(CostmapParams, top, where=name, extra={"plugins": tuple(specs)})
     return params, tuple(warnings) + res.warnings
 

@@ -64,6 +64,7 @@ from roverlab.navigation.move_base.plugins import (
     plugin_short_name,
     rotate_fallback,
 )
+from roverlab.navigation.move_base.potential import PotentialPublisher
 from roverlab.navigation.move_base.recovering import Recovering
 from roverlab.navigation.node_params import parameters_under
 from roverlab.navigation.planners import Path2D, path_to_msg
@@ -195,6 +196,7 @@ class MoveBase(Node):
         self.cmd_pub = self.create_publisher(Twist, "cmd_vel", 1)
         self.goal_pub = self.create_publisher(PoseStamped, "~/current_goal", 1)
         self.plan_pub = self.create_publisher(Path, f"~/{gname}/plan", 1)
+        self.potential_pub = PotentialPublisher(self, gname, self.planner)
         self.local_global_plan_pub = self.create_publisher(Path, f"~/{lname}/global_plan", 1)
         self.local_plan_pub = self.create_publisher(Path, f"~/{lname}/local_plan", 1)
         self.server = SimpleActionServer(self, "move_base", "move_base_msgs/MoveBaseAction")
@@ -472,6 +474,7 @@ class MoveBase(Node):
         if self.recovery_trigger == PLANNING_R:
             self.recovery_index = 0
         self._publish_path(self.plan_pub, self.plan, self.global_frame)
+        self.potential_pub.publish(gpose, self.global_frame, self.global_costmap.costmap.resolution)
         try:
             self.controller.set_plan(self._plan_in_local_frame())
         except (TransformException, NavigationError) as err:
