@@ -70,12 +70,26 @@ def test_parameters_validation_and_unimplemented_names() -> None:
     p, warnings = TebParams.from_ros(
         {**TEB, "enable_homotopy_class_planning": True, "max_vel_x_backwards": 0.0}
     )
-    assert any("enable_homotopy_class_planning is not implemented" in w for w in warnings)
+    assert any("homotopy class planning is not implemented" in w for w in warnings)
     assert any("max_vel_x_backwards to be <= 0" in w for w in warnings)
-    with pytest.raises(NavigationParamsError, match="max_vel_y must be 0"):
-        TebParams.from_ros({"max_vel_y": 0.2})
-    with pytest.raises(NavigationParamsError, match="unknown parameter 'dt_reff'"):
-        TebParams.from_ros({"dt_reff": 0.3})
+    # teb's default is homotopy planning on: a user who never set it is told too
+    _, silent = TebParams.from_ros({"enable_homotopy_class_planning": False})
+    _, told = TebParams.from_ros({})
+    assert silent == () and any("enable_homotopy_class_planning is true" in w for w in told)
+    holo, warnings = TebParams.from_ros({"max_vel_y": 0.2, "enable_homotopy_class_planning": False})
+    assert holo.max_vel_y == 0.0 and any("max_vel_y 0.2 ignored" in w for w in warnings)
+    misspelt, warnings = TebParams.from_ros(
+        {"dt_reff": 0.3, "enable_homotopy_class_planning": False, "odom_topic": "odom",
+         "max_number_classes": 4, "obstacle_proximity_ratio_max_vel": 1.0,
+         "costmap_converter": {"CostmapToPolygonsDBSMCCH": {"cluster_max_distance": 0.4}},
+         "footprint_model": {"type": "circular", "radius": 0.2, "raduis": 0.3}}
+    )  # fmt: skip
+    assert misspelt.dt_ref == 0.3 and misspelt.footprint_model.values == (0.2,)
+    text = "\n".join(warnings)
+    assert "unknown parameter 'dt_reff' (did you mean dt_ref?)" in text
+    assert "max_number_classes" in text and "obstacle_proximity_ratio_max_vel" in text
+    assert "costmap_converter/CostmapToPolygonsDBSMCCH/cluster_max_distance" in text
+    assert "'raduis'" in text and "odom_topic" not in text
     with pytest.raises(NavigationParamsError, match="dt_hysteresis"):
         TebParams(dt_ref=0.3, dt_hysteresis=0.4)
     assert p.trans_limit == p.max_vel_x

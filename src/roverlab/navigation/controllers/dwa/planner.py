@@ -15,6 +15,14 @@ Per control cycle, as DWAPlannerROS::computeVelocityCommands:
   ``sim_time`` and scored by the critics of :mod:`.kernels` in one compiled call; the
   cheapest valid sample is the command, and the oscillation flags are updated.
 
+When every sample is refused, base_local_planner's escape (TrajectoryPlanner's
+``escape_vel``, ``escape_reset_dist``, ``escape_reset_theta``, here for DWAPlannerROS too):
+the robot backs up at ``escape_vel`` and forward samples are left out until it has moved
+``escape_reset_dist`` or turned ``escape_reset_theta`` from where the escape began. ROS
+backs up blind ("even when the static map shows it as blocked"); roverlab backs up only
+while the robot's real (unpadded) footprint stays clear of lethal cells, which is what
+frees a robot whose *padded* footprint touches an obstacle its body clears.
+
 Failures raise :class:`NoValidControlError` (the robot must stop) or
 :class:`InvalidPathError`.
 """
@@ -127,10 +135,20 @@ class DWAPlanner:
 
     name = "dwa_local_planner/DWAPlannerROS"
 
-    def __init__(self, params: DWAParams | None = None, *, footprint: ArrayLike = ()) -> None:
+    def __init__(
+        self,
+        params: DWAParams | None = None,
+        *,
+        footprint: ArrayLike = (),
+        body_footprint: ArrayLike | None = None,
+    ) -> None:
         self.params = params or DWAParams()
         fp = np.asarray(footprint, dtype=np.float64).reshape(-1, 2)
         self.footprint = np.ascontiguousarray(fp)
+        body = fp if body_footprint is None else np.asarray(body_footprint, dtype=np.float64)
+        self.body_footprint = np.ascontiguousarray(body.reshape(-1, 2))
+        self.escaping = False
+        self._escape_from = SE2()
         self._orig_plan: NDArray[np.float64] | None = None
         self._plan: NDArray[np.float64] = np.zeros((0, 3))
         self.local_plan: NDArray[np.float64] = np.zeros((0, 3))
@@ -367,12 +385,18 @@ class DWAPlanner:
         self.trajectory = np.zeros((0, 3))
         if self._position_reached(pose):
             return self._stop_rotate(pose, twist, costmap)
+        self._update_escape(pose)
         samples = self._sample_velocities(pose, twist)
+        if self.escaping:  # TrajectoryPlanner samples no forward motion while escaping
+            samples = samples[samples[:, 0] <= 0.0]
         best, costs = self._score(pose, twist, samples, costmap, self._only)
         if best < 0:
             best, costs = self._escape(pose, twist, samples, costmap, costs)
         self.samples, self.costs = samples, costs
         if best < 0:
+            back = self._back_up(pose, twist, costmap)
+            if back is not None:
+                return back
             raise NoValidControlError(
                 "dwa_local_planner: the dwa local planner failed to find a valid plan, cost "
                 "functions discarded all candidates. This can mean there is an obstacle too "
@@ -439,6 +463,50 @@ class DWAPlanner:
                 continue
             return int(k), rcosts
         return -1, costs
+
+    def _update_escape(self, pose: SE2) -> None:
+        """The escape ends once the robot is ``escape_reset_dist`` away from, or
+        ``escape_reset_theta`` turned from, where it began."""
+        if not self.escaping:
+            return
+        p, start = self.params, self._escape_from
+        if (
+            math.hypot(pose.x - start.x, pose.y - start.y) > p.escape_reset_dist
+            or abs(angle_diff(pose.theta, start.theta)) > p.escape_reset_theta
+        ):
+            self.escaping = False
+
+    def _back_up(self, pose: SE2, twist: Velocity2D, cm: Costmap2D) -> Velocity2D | None:
+        """TrajectoryPlanner's last resort: straight back at ``escape_vel`` (acceleration
+        limited), if the real footprint stays clear of lethal and unknown cells for
+        ``escape_reset_dist`` (or the whole ``sim_time`` if that is shorter); None
+        otherwise (or with ``escape_vel`` 0)."""
+        p = self.params
+        if p.escape_vel >= 0.0:
+            return None
+        cmd = np.array([p.escape_vel, 0.0, 0.0])
+        acc = np.array([p.acc_lim_x, p.acc_lim_y, p.acc_lim_theta])
+        traj = np.empty((int(p.sim_time / min(p.sim_granularity, 1.0)) * 4 + 64, 3))
+        num, _, _ = rollout(
+            pose.as_array(), twist.as_array(), cmd, p.sim_time, p.sim_granularity,
+            p.angular_sim_granularity, True, acc, 0.0, traj,
+        )  # fmt: skip
+        need = min(p.escape_reset_dist, abs(p.escape_vel) * p.sim_time)
+        line = np.empty((cm.size_x + cm.size_y + 4, 2), dtype=np.int64)
+        for x, y, th in traj[:num]:
+            if footprint_cost(
+                cm.costs, cm.resolution, cm.origin_x, cm.origin_y, float(x), float(y),
+                float(th), self.body_footprint, 1.0, line,
+            ) < 0:  # fmt: skip
+                return None
+            if math.hypot(x - pose.x, y - pose.y) >= need:
+                break
+        if not self.escaping:
+            self.escaping = True
+            self._escape_from = pose
+        self.trajectory = traj[:num].copy()
+        vx = max(p.escape_vel, twist.vx - p.acc_lim_x * p.sim_period)
+        return Velocity2D(vx, 0.0, 0.0)
 
     def _stop_rotate(self, pose: SE2, twist: Velocity2D, cm: Costmap2D) -> Velocity2D:
         """LatchedStopRotateController::computeVelocityCommandsStopRotate."""
