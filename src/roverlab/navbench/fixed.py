@@ -29,6 +29,7 @@ from scipy import ndimage
 
 from roverlab.actionlib import GoalStatus, SimpleActionClient
 from roverlab.actionlib.status import STATUS_NAMES
+from roverlab.batch import episode_stop
 from roverlab.core import Context
 from roverlab.description import find_package
 from roverlab.fileio import atomic_write_bytes
@@ -152,7 +153,7 @@ class FixedResult:
     """How one episode ended (``record`` holds the path, contacts, failures...)."""
 
     name: str
-    status: str  # succeeded, collided, timeout
+    status: str  # succeeded, collided, timeout (interrupted: stopped by Ctrl-C)
     record: GoalRecord
     time_s: float
     reference_m: float | None
@@ -368,8 +369,11 @@ class _Episode:
         self.trace = [(self._t_sent, *start)]
         self._contacts = c0 = s.contacts
         self.client.send_goal(_goal_msg(self.frame, goal))
-        self.ctx.wait_for(lambda: self.outcome is not None, cfg.time_limit_s * 3 + 60.0)
-        outcome = self.outcome or "timeout"
+        stop = episode_stop()  # Ctrl-C in a serial batch: end here, reported as interrupted
+        self.ctx.wait_for(
+            lambda: self.outcome is not None or stop.is_set(), cfg.time_limit_s * 3 + 60.0
+        )
+        outcome = self.outcome or ("interrupted" if stop.is_set() else "timeout")
         t_end = self._now()
         state = self.client.get_state()
         done = state not in (GoalStatus.PENDING, GoalStatus.ACTIVE)

@@ -136,7 +136,7 @@ def summarize(rows: list[dict[str, Any]], **extra: Any) -> dict[str, Any]:
     """``summary.json``: worlds, rates, BARN's mean score, mean time of the successful
     episodes, the worst world's control-cycle CPU p99, the real-time factor per CPU
     second of the whole stack, and what was run (``extra``)."""
-    ok = [r for r in rows if not r.get("error")]
+    ok = [r for r in rows if not r.get("error") and r.get("status") != "interrupted"]
     n = len(ok)
 
     def rate(status: str) -> float | None:
@@ -148,7 +148,8 @@ def summarize(rows: list[dict[str, Any]], **extra: Any) -> dict[str, Any]:
     scores = [r["score"] for r in ok if r.get("score") is not None]
     return {
         "worlds": n,
-        "errors": len(rows) - n,
+        "errors": sum(1 for r in rows if r.get("error")),
+        "interrupted": sum(1 for r in rows if r.get("status") == "interrupted"),
         "success_rate": rate("succeeded"),
         "collision_rate": rate("collided"),
         "timeout_rate": rate("timeout"),
