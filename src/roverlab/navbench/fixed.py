@@ -316,6 +316,7 @@ class _Episode:
         self.contact_points: list[tuple[float, float]] = []
         self.t_start: float | None = None
         self.outcome: str | None = None
+        self._t_sent: float | None = None  # the outcome is judged once the goal is out
         self.recoveries = 0
         self._mb_state = ""
         self._contacts = 0
@@ -334,7 +335,7 @@ class _Episode:
         if state == "CLEARING" and self._mb_state != "CLEARING":
             self.recoveries += 1
         self._mb_state = state
-        if self.outcome is not None:
+        if self.outcome is not None or self._t_sent is None:
             return
         if self.t_start is None and math.hypot(s.x - cfg.start[0], s.y - cfg.start[1]) >= (
             cfg.start_move_m
@@ -349,7 +350,7 @@ class _Episode:
                 return
         if math.hypot(s.x - cfg.goal[0], s.y - cfg.goal[1]) <= cfg.goal_tolerance_m:
             self.outcome = "succeeded"
-        elif t - (self.t_start if self.t_start is not None else self._t_sent) >= cfg.time_limit_s:
+        elif t - (self.t_start if self.t_start is not None else self._t_sent) >= (cfg.time_limit_s):
             self.outcome = "timeout"
         elif self.client.get_state() not in (GoalStatus.PENDING, GoalStatus.ACTIVE):
             self.outcome = "timeout"  # given up (or "reached" short of the tolerance)
