@@ -13,6 +13,7 @@ import pytest
 from roverlab.core import Context
 from roverlab.description import RosControlSpec, load_robot
 from roverlab.description.check import format_check
+from roverlab.launch import build_launch
 from roverlab.msgs import Twist
 from roverlab.sim.app import Simulation
 from roverlab.sim.node import SpawnPose
@@ -181,3 +182,27 @@ def test_controller_yaml_file_drives_a_two_wheeler(tmp_path: Path) -> None:
     assert sim.simulator.w == pytest.approx(1.0)
     assert got["/duo/base_controller/odom"][-1].twist.twist.angular.z == pytest.approx(0.5)
     assert not any(t.child_frame_id == "base_link" for m in got["/tf"] for t in m.transforms)
+
+
+def test_a_launch_file_with_controller_manager_spawner_drives_jackal(tmp_path: Path) -> None:
+    launch = tmp_path / "jackal.launch"
+    launch.write_text(
+        "<launch>\n"
+        '  <include file="$(find gazebo_ros)/launch/empty_world.launch">\n'
+        '    <arg name="world_name" value="empty"/>\n  </include>\n'
+        '  <param name="robot_description" command="$(find xacro)/xacro '
+        '$(find jackal_description)/urdf/jackal.urdf.xacro"/>\n'
+        '  <node name="spawner" pkg="gazebo_ros" type="spawn_model" '
+        'args="-urdf -model jackal -param robot_description"/>\n'
+        '  <include file="$(find jackal_control)/launch/control.launch"/>\n'
+        "</launch>\n"
+    )
+    ctx = Context()
+    built = build_launch(launch, {}, context=ctx)
+    sim = built.simulator
+    assert sim is not None and isinstance(sim.robot.drive, DiffDriveControllerConfig)
+    node = ctx.create_node("driver")
+    pub = node.create_publisher(Twist, "/jackal_velocity_controller/cmd_vel", 10)
+    node.create_timer(0.05, lambda: pub.publish(Twist(linear_x=0.5)))
+    ctx.spin_for(1.0)
+    assert sim.v == pytest.approx(0.5, abs=0.05) and sim.x > 0.3  # 2 % wheel slip

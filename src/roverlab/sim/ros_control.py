@@ -355,6 +355,8 @@ class DiffDriveControllerPlugin:
         self._published_ns = self._odom_ns
         self._pose_cov = _diag(c.pose_covariance)
         self._twist_cov = _diag(c.twist_covariance)
+        for w in c.warnings:
+            node.get_logger().warning(w)
         node.create_subscription(mc.Twist, c.command_topic, self.on_cmd, 10)
         self.odom_pub = node.create_publisher(mc.Odometry, c.odometry_topic, 10)
         node.create_timer(1.0 / c.publish_rate_hz, self.publish_odometry)
