@@ -132,6 +132,11 @@ def _mean(values: list[float]) -> float | None:
     return round(float(np.mean(vals)), 4) if vals else None
 
 
+def _median(values: list[float | None]) -> float | None:
+    vals = [v for v in values if v is not None and math.isfinite(v)]
+    return round(float(np.median(vals)), 2) if vals else None
+
+
 def summarize(rows: list[dict[str, Any]], **extra: Any) -> dict[str, Any]:
     """``summary.json``: worlds, rates, BARN's mean score, mean time of the successful
     episodes, the worst world's control-cycle CPU p99, the real-time factor per CPU
@@ -160,6 +165,8 @@ def summarize(rows: list[dict[str, Any]], **extra: Any) -> dict[str, Any]:
         if p99
         else None,
         "rtf_per_cpu_s": round(sim / cpu, 2) if cpu > 0 else None,
+        # per world (the first world of a process also loads the compiled kernels)
+        "rtf_per_cpu_s_median": _median([r.get("rtf_per_cpu_s") for r in ok]),
         "sim_time_s": round(sim, 2),
         "cpu_s": round(cpu, 2),
         **extra,
