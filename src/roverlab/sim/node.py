@@ -64,6 +64,7 @@ from roverlab.sim.dynamics import (
     advance_packed,
     compiled_entry,
 )
+from roverlab.sim.odometry import publish_planar_odometry
 from roverlab.sim.planar_move import PlanarMovePlugin
 from roverlab.sim.ros_control import DiffDriveControllerConfig, DiffDriveControllerPlugin
 from roverlab.sim.sensors import CameraModel, ImuModel, LidarModel
@@ -347,23 +348,12 @@ class SimulatorNode(Node):
         else:
             x, y, yaw = st[S_X], st[S_Y], st[S_TH]
             v, w = st[S_V], st[S_W]
-        sec, nsec = divmod(ns, 1_000_000_000)
-        half = 0.5 * yaw
-        qz, qw = math.sin(half), math.cos(half)
-        frame, child = d.odometry_frame, d.robot_base_frame
-        self.odom_pub.publish(
-            build.odometry(
-                sec, nsec, frame, child, x, y, 0.0, 0.0, 0.0, qz, qw, self._pose_cov,
-                v, 0.0, 0.0, 0.0, 0.0, w, self._twist_cov,
-            )
+        publish_planar_odometry(
+            self.odom_pub, self._tf_pub if d.publish_odom_tf else None, ns,
+            d.odometry_frame, d.robot_base_frame, (x, y, yaw), (v, 0.0, w),
+            self._pose_cov, self._twist_cov,
         )  # fmt: skip
-        # the transform is built only when someone reads /tf (here or in another process)
-        if d.publish_odom_tf and self._tf_pub.has_listeners:
-            self._tf_pub.publish(
-                build.tf_message(
-                    [build.transform_stamped(sec, nsec, frame, child, x, y, 0.0, 0.0, 0.0, qz, qw)]
-                )
-            )
+        sec, nsec = divmod(ns, 1_000_000_000)
         if self.joint_pub is not None:
             # one buffer for position, velocity (wheel surface speed / radius) and effort
             k = self._wheel_k

@@ -48,10 +48,10 @@ from roverlab.core.node import Publisher
 from roverlab.description import Cylinder, RobotModel, Sphere
 from roverlab.errors import RoverlabError
 from roverlab.geometry import wrap_angle
-from roverlab.msgs import builders as build
 from roverlab.msgs import classes as mc
 from roverlab.sim.diff_drive import DiffDriveParams
 from roverlab.sim.dynamics import S_AL, S_AR, S_TL, S_TR
+from roverlab.sim.odometry import publish_planar_odometry
 
 __all__ = [
     "DIFF_DRIVE_CONTROLLER",
@@ -450,22 +450,11 @@ class DiffDriveControllerPlugin:
         self._travel = (0.0, 0.0)
         self._published_ns = now
         v, w = (lin / dt, ang / dt) if dt > 0 else (0.0, 0.0)
-        x, y, th = self.pose
-        sec, nsec = divmod(now, 1_000_000_000)
-        qz, qw = math.sin(0.5 * th), math.cos(0.5 * th)
-        frame, child = c.odometry_frame, c.robot_base_frame
-        self.odom_pub.publish(
-            build.odometry(
-                sec, nsec, frame, child, x, y, 0.0, 0.0, 0.0, qz, qw, self._pose_cov,
-                v, 0.0, 0.0, 0.0, 0.0, w, self._twist_cov,
-            )
+        publish_planar_odometry(
+            self.odom_pub, self._tf_pub if c.publish_odom_tf else None, now,
+            c.odometry_frame, c.robot_base_frame, (self.pose[0], self.pose[1], self.pose[2]),
+            (v, 0.0, w), self._pose_cov, self._twist_cov,
         )  # fmt: skip
-        if c.publish_odom_tf and self._tf_pub.has_listeners:
-            self._tf_pub.publish(
-                build.tf_message(
-                    [build.transform_stamped(sec, nsec, frame, child, x, y, 0.0, 0.0, 0.0, qz, qw)]
-                )
-            )
 
     def reset(self) -> None:
         """A teleport: the body is at rest, the command is dropped."""
