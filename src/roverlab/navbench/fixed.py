@@ -17,6 +17,7 @@ import csv
 import io
 import json
 import math
+import tempfile
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -268,6 +269,8 @@ def _goal_msg(frame: str, p: tuple[float, float, float]) -> dict[str, Any]:
 class _Episode:
     def __init__(self, cfg: FixedConfig, log: Callable[[str], None]) -> None:
         self.cfg = cfg
+        # the rasterised map of a map-based run: per episode (parallel episodes share out)
+        self._tmp = tempfile.TemporaryDirectory(prefix="roverlab-fixed-")
         self.ctx = Context()
         world = load_world(cfg.world)
         self.sim = Simulation(
@@ -287,11 +290,14 @@ class _Episode:
                 args["teb_params"] = str(Path(cfg.teb_params).resolve())
             self.frame = "odom"
         else:
-            Path(cfg.out).mkdir(parents=True, exist_ok=True)
             launch = cfg.launch or pkg / "nav_bench.launch"
             drive = self.sim.config.drive
             args |= {
-                "map_file": str(_map_for(world, self.sim, Path(cfg.out)).resolve()),
+                "map_file": str(
+                    _map_for(
+                        world, self.sim, Path(cfg.out), (cfg.start[:2], cfg.goal[:2])
+                    ).resolve()
+                ),
                 "localization": cfg.localization,
                 "base_frame": drive.robot_base_frame if drive else "base_link",
                 "initial_pose_x": repr(cfg.start[0]),
@@ -464,6 +470,7 @@ def run_fixed(
         result = ep.run()
     finally:
         ep.ctx.shutdown()
+        ep._tmp.cleanup()
     pts = [cfg.start[:2], cfg.goal[:2]]
     if cfg.reference is not None:
         pts += list(cfg.reference)
