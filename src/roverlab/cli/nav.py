@@ -222,7 +222,8 @@ def bench(
         float | None,
         typer.Option(
             "--goal-tolerance",
-            help="Success radius, m (true position; default 0.25, 1.0 with --start/--goal).",
+            help="Success radius of a fixed goal, m (true position; default 1.0; random "
+            "goals count 0.25).",
         ),
     ] = None,
     time_limit: Annotated[
@@ -275,6 +276,8 @@ def bench(
             max_worlds=max_worlds, workers=workers, ray_address=ray_address, quiet=quiet,
         )  # fmt: skip
         return
+    if goal_tolerance is not None:
+        raise BenchError("--goal-tolerance is for fixed goals (--start/--goal, --suite)")
     robot = robot or "mybot"
     localization = (localization or "amcl").replace("-", "_")
     if localization not in LOCALIZATIONS:
