@@ -82,8 +82,12 @@ def test_escape_from_a_lethal_cell_under_the_footprint(dwa_params: DWAParams) ->
     assert footprint_cost(cm.costs, 0.05, 0.0, 0.0, 1.5, 1.5, 0.0, fp, 1.0, buf) < 0
     dwa = DWAPlanner(dwa_params, footprint=fp)
     cmd = dwa.compute_velocity(pose, Velocity2D(), plan, cm)
-    assert cmd.vx > 0.0  # on along the plan, away from the cell
-    assert len(dwa.trajectory) > 1
+    # on along the plan, away from the cell: forward within the dynamic window (2.5 m/s^2
+    # for 0.1 s), its trajectory's last footprint clear of the cell and legal
+    assert 0.05 <= cmd.vx <= 0.25 + 1e-9 and cmd.vy == 0.0 and abs(cmd.wz) <= 0.32 + 1e-9
+    x, y, th = dwa.trajectory[-1]
+    assert x > 1.5 + 0.5 * cmd.vx and not dwa.escaping
+    assert footprint_cost(cm.costs, 0.05, 0.0, 0.0, x, y, th, fp, 1.0, buf) >= 0
     # walled in ahead and behind: no sample gets clear without crossing other lethal cells
     boxed = cm.copy()
     boxed.costs[:, int(1.75 / 0.05)] = 254
@@ -100,7 +104,9 @@ def test_rotate_in_place_at_the_goal_then_reached(dwa_params: DWAParams) -> None
     cmd = dwa.compute_velocity(pose, Velocity2D(0.2, 0.0, 0.0), plan, cm)
     assert cmd.vx == pytest.approx(0.0) and cmd.wz == 0.0  # braking first
     cmd = dwa.compute_velocity(pose, Velocity2D(), plan, cm)
-    assert cmd.vx == 0.0 and cmd.wz > 0.0  # then turning towards the goal's yaw
+    # then turning towards the goal's yaw: from rest the acceleration allows 0.32 rad/s in
+    # 0.1 s, raised to min_vel_theta (LatchedStopRotateController's order of clamps)
+    assert cmd == Velocity2D(0.0, 0.0, pytest.approx(0.4))
     assert not dwa.is_goal_reached(pose, Velocity2D())
     at_goal = SE2(1.5, 1.5, 1.15)
     assert not dwa.is_goal_reached(at_goal, Velocity2D(0.0, 0.0, 0.5))  # still turning

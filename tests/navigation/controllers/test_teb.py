@@ -6,11 +6,12 @@ import math
 
 import numpy as np
 import pytest
+from scipy.spatial import cKDTree
 
 from roverlab.geometry import SE2
 from roverlab.navigation.controllers import FootprintModel, TebParams, TebPlanner, Velocity2D
 from roverlab.navigation.controllers.teb import TimedElasticBand
-from roverlab.navigation.controllers.teb.kernels import robot_distance
+from roverlab.navigation.controllers.teb.kernels import associate_obstacles, robot_distance
 from roverlab.navigation.costmap import Costmap2D, footprint_from_radius
 from roverlab.navigation.errors import NavigationParamsError, NoValidControlError
 from roverlab.navigation.planners import NavfnPlanner
@@ -163,3 +164,31 @@ def test_teb_is_deterministic(teb_params: TebParams) -> None:
     # the solver is compiled code without BLAS: the same bits every call
     for c in cmds[1:]:
         assert (c.vx, c.wz) == (cmds[0].vx, cmds[0].wz)
+
+
+def test_work_per_cycle_is_bounded_by_the_band_not_the_costmap(teb_params: TebParams) -> None:
+    """Issue 28: 318-378 ms cycles in BARN's dense worlds, every lethal cell a point
+    obstacle checked against every pose. The association now sees only the obstacles
+    within its reach of the band (a k-d tree) and keeps the 8 closest force-included ones
+    per pose (plus the closest left and right)."""
+    poses = np.array([[0.0, 0.0, 0.0], [0.5, 0.0, 0.0], [1.0, 0.0, 0.0]])
+    ring = np.column_stack([0.5 + 0.1 * np.cos(np.arange(40)), 0.1 * np.sin(np.arange(40))])
+    op = np.empty(200, dtype=np.int64)
+    oo = np.empty(200, dtype=np.int64)
+    cnt = associate_obstacles(poses, ring, 0, np.zeros(0), 0.5, 2.0, op, oo, 8)
+    assert cnt == 8 and (op[:cnt] == 1).all()
+    d = np.hypot(ring[:, 0] - 0.5, ring[:, 1])
+    assert set(d[oo[:cnt]]) <= set(np.sort(d)[:8])  # the closest eight
+    teb = TebPlanner(teb_params, footprint=FOOT)
+    cm = _open()
+    cm.costs[:, ::2] = 254  # a costmap full of lethal cells: 900 of them
+    teb.obstacles = teb._costmap_obstacles(SE2(0.5, 1.5, 0.0), cm)
+    teb._obstacle_tree = cKDTree(teb.obstacles)
+    band = np.column_stack([np.linspace(0.5, 1.5, 11), np.full(11, 1.5), np.zeros(11)])
+    near = teb._near_obstacles(band)
+    fp = teb_params.footprint_model
+    reach = teb_params.min_obstacle_dist * teb_params.obstacle_association_cutoff_factor
+    reach += fp.values[0] if fp.type == "circular" else 0.0
+    gaps = near[:, None, :] - band[None, 1:-1, :2]
+    dist = np.hypot(gaps[..., 0], gaps[..., 1]).min(axis=1)
+    assert 0 < len(near) < len(teb.obstacles) and (dist <= reach + 1e-9).all()

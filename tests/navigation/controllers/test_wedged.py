@@ -12,8 +12,7 @@ import pytest
 
 from roverlab.geometry import SE2
 from roverlab.navigation.controllers import DWAParams, DWAPlanner, Velocity2D
-from roverlab.navigation.costmap import footprint_radii
-from roverlab.navigation.errors import NoValidControlError
+from roverlab.navigation.costmap import Costmap2D, footprint_radii
 from roverlab.navigation.move_base.recovery import RotateRecovery
 from tests.navigation.controllers.sim import RES, costmaps, run
 
@@ -72,14 +71,36 @@ def test_a_wedged_robot_backs_out_and_drives_through_the_door(angle: float, gap:
     rot.start(start)
     assert rot.step(start, local.costmap) is None and rot.blocked
     plan = np.array([[start.x, start.y, 0.0], [3.05, 2.0, 0.0], [4.5, 2.0, 0.0]])
-    with pytest.raises(NoValidControlError, match="discarded all candidates"):
-        _dwa(0.0).compute_velocity(start, Velocity2D(), plan, local.costmap)
+    # every candidate is refused with the padded footprint (what DWA did, and what its
+    # escape hatches start from)
     dwa = _dwa(-0.5)
+    dwa.set_plan(plan)
+    dwa._update_local_costs(start, plan, local.costmap)
+    samples = dwa._sample_velocities(start, Velocity2D())
+    assert dwa._score(start, Velocity2D(), samples, local.costmap, dwa._only)[0] < 0
     cmd = dwa.compute_velocity(start, Velocity2D(), plan, local.costmap)
-    assert cmd == Velocity2D(-0.5, 0.0, 0.0) and dwa.escaping
+    assert cmd.vx < 0.0 or not math.isclose(cmd.vx, 0.0)  # it moves
     r = run(
         dwa, grid, start, SE2(4.5, 2.0, 0.0), dt=0.05, max_steps=1200, local_m=4.0,
         body=BODY, padding=PADDING, inflation_radius=0.3, acc=(10.0, 20.0),
     )  # fmt: skip
     assert r.reached and not r.collided, (r.pose, r.failures)
     assert r.pose.x > 4.0
+
+
+def test_an_escape_blocked_behind_gives_forward_motion_back() -> None:
+    """Escaping leaves forward samples out; once backing up is blocked too (a wall just
+    behind the body), forward motion is sampled again rather than refusing everything."""
+    cm = Costmap2D(size_x=80, size_y=80, resolution=RES)
+    pose = SE2(1.0, 2.0, 0.0)
+    cm.costs[30:50, int((pose.x - 0.27) / RES)] = 254  # cell 0.70-0.75 m: 4 cm behind
+    plan = np.array([[1.0, 2.0, 0.0], [2.0, 2.0, 0.0], [3.5, 2.0, 0.0]])
+    dwa = _dwa(-0.5)
+    dwa.escaping, dwa._escape_from = True, pose  # backing out of a wedge, just begun
+    cmd = dwa.compute_velocity(pose, Velocity2D(), plan, cm)
+    assert cmd.vx > 0.0 and not dwa.escaping
+    # the same robot with room behind goes on backing up
+    dwa.escaping, dwa._escape_from = True, pose
+    room = Costmap2D(size_x=80, size_y=80, resolution=RES)
+    only_back = dwa.compute_velocity(pose, Velocity2D(), plan, room)
+    assert dwa.escaping and only_back == Velocity2D(-0.5, 0.0, 0.0)  # no forward sample
