@@ -60,15 +60,15 @@ def test_check_lists_sensors_and_plugins() -> None:
 def test_check_marks_unsupported_plugins_and_unknown_references() -> None:
     m = load_robot(
         robot(
-            '<link name="a"/><gazebo><plugin name="ctl" filename="libgazebo_ros_control.so"/>'
+            '<link name="a"/><gazebo><plugin name="ctl" filename="libgazebo_ros_p3d.so"/>'
             '</gazebo><gazebo reference="ghost"><material>Gazebo/Red</material></gazebo>'
             '<gazebo reference="a"><sensor type="sonar" name="s"/></gazebo>'
         )
     )
     text = format_check(m)
-    assert "  ctl [libgazebo_ros_control.so] on model: not supported by roverlab" in text
+    assert "  ctl [libgazebo_ros_p3d.so] on model: not supported by roverlab" in text
     assert "  s (sonar) on a: not supported by roverlab" in text
-    assert "unsupported (ignored): plugin libgazebo_ros_control.so, sensor type sonar" in text
+    assert "unsupported (ignored): plugin libgazebo_ros_p3d.so, sensor type sonar" in text
     assert "warning: <gazebo reference> names no link or joint: 'ghost'" in text
 
 

@@ -190,7 +190,7 @@ def test_kinect_defaults() -> None:
 def test_unknown_plugins_are_kept_generically() -> None:
     m = load_robot(
         with_gazebo(
-            '<gazebo><plugin name="ctrl" filename="libgazebo_ros_control.so">'
+            '<gazebo><plugin name="ctrl" filename="libgazebo_ros_p3d.so">'
             "<robotNamespace>/mybot</robotNamespace><nested><a>1</a></nested></plugin></gazebo>"
         )
     )

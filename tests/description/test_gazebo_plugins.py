@@ -168,17 +168,6 @@ def test_the_imu_sensor_plugin_publishes_in_the_simulator() -> None:
     assert got["/imu"][-1].linear_acceleration.z == pytest.approx(9.8, abs=0.1)
 
 
-def test_gazebo_ros_control_is_warned_with_what_it_means() -> None:
-    m = load_robot(
-        '<robot name="r"><link name="a"/><gazebo><plugin name="c" '
-        'filename="libgazebo_ros_control.so"><robotNamespace>/</robotNamespace></plugin>'
-        "</gazebo></robot>",
-    )
-    (hint,) = [w for w in robot_warnings(m) if "ros_control controllers" in w]
-    assert hint.startswith("<string>: libgazebo_ros_control.so: ros_control controllers")
-    assert "libgazebo_ros_diff_drive.so" in hint and "libgazebo_ros_planar_move.so" in hint
-
-
 def _planar(plugin: str) -> str:
     return (
         '<robot name="omni"><link name="base_footprint"/><link name="base_link"/>'

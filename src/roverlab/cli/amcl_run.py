@@ -160,7 +160,10 @@ def run(
     if initial is not None and global_start:
         raise AmclError("--initial and --global exclude each other")
     raw = parse_params(param, AmclError)
-    params = AmclParams.from_ros(raw)
+    warnings: list[str] = []
+    params = AmclParams.from_ros(raw, warnings=warnings)
+    for w in warnings:
+        typer.echo(f"warning: {w}", err=True)
     occupancy = load_map(map_yaml)
     try:
         amcl_map = map_for_amcl(occupancy, params)

@@ -30,6 +30,7 @@ from roverlab.description.gazebo_specs import (
     KinectPluginSpec,
     LaserPluginSpec,
     PlanarMoveSpec,
+    RosControlSpec,
 )
 from roverlab.description.meshes import mesh_points
 from roverlab.description.model import Mesh, RobotModel
@@ -52,13 +53,6 @@ def robot_warnings(model: RobotModel) -> list[str]:
     sensors = list(dict.fromkeys(s.type for s in model.gazebo.unsupported_sensors))
     if plugins:
         out.append(f"{src}: Gazebo plugins not simulated (ignored): {', '.join(plugins)}")
-    if "libgazebo_ros_control.so" in plugins:
-        out.append(
-            f"{src}: libgazebo_ros_control.so: ros_control controllers (diff_drive_controller, "
-            "joint_state_controller) are not run, so nothing moves the robot on cmd_vel; "
-            "add a libgazebo_ros_diff_drive.so or libgazebo_ros_skid_steer_drive.so plugin "
-            "(libgazebo_ros_planar_move.so for an omni-wheel or mecanum base)"
-        )
     if sensors:
         out.append(f"{src}: Gazebo sensor types not simulated (ignored): {', '.join(sensors)}")
     out += _shape_warnings(model)
@@ -318,6 +312,11 @@ def _plugin_line(p: GazeboPlugin) -> str:
         )
     elif isinstance(spec, PlanarMoveSpec):
         detail = _planar_move_detail(spec)
+    elif isinstance(spec, RosControlSpec):
+        detail = (
+            f": ros_control in namespace {spec.robot_namespace}; a diff_drive_controller's "
+            "parameters there move the robot"
+        )
     elif isinstance(spec, LaserPluginSpec):
         detail = f": {spec.topic} in frame {spec.frame_id}"
     elif isinstance(spec, CameraPluginSpec):

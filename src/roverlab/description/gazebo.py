@@ -31,7 +31,7 @@ from types import MappingProxyType
 from typing import Final, TypedDict
 
 from roverlab.description.errors import URDFError
-from roverlab.description.gazebo_planar import parse_planar_move
+from roverlab.description.gazebo_planar import parse_planar_move, parse_ros_control
 from roverlab.description.gazebo_specs import (
     CameraPluginSpec,
     CameraSpec,
@@ -356,6 +356,7 @@ PLUGIN_SPECS: Final[Mapping[str, _SpecParser]] = MappingProxyType(
         "libgazebo_ros_diff_drive.so": lambda v, p, e: _diff_drive(v, p),
         "libgazebo_ros_skid_steer_drive.so": lambda v, p, e: _skid_steer(v, p),
         "libgazebo_ros_planar_move.so": lambda v, p, e: parse_planar_move(v),
+        "libgazebo_ros_control.so": lambda v, p, e: parse_ros_control(v),
         "libgazebo_ros_laser.so": lambda v, p, e: _laser(v, p),
         "libgazebo_ros_gpu_laser.so": lambda v, p, e: _laser(v, p),
         "libgazebo_ros_camera.so": lambda v, p, e: _camera_plugin(v, p),

@@ -1,5 +1,6 @@
 """``libgazebo_ros_planar_move.so``: the holonomic base plugin of omni-wheel and mecanum
-robots (ROS 1 noetic's ``GazeboRosPlanarMove``), read into a :class:`PlanarMoveSpec`.
+robots (ROS 1 noetic's ``GazeboRosPlanarMove``), read into a :class:`PlanarMoveSpec`; and
+``libgazebo_ros_control.so`` (ros_control in Gazebo), read into a :class:`RosControlSpec`.
 
 The plugin reads ``robotNamespace`` (``""``), ``commandTopic`` (``cmd_vel``),
 ``odometryTopic`` (``odom``), ``odometryFrame`` (``odom``), ``robotBaseFrame``
@@ -10,10 +11,15 @@ switch for its ``odom -> robotBaseFrame`` transform; roverlab reads
 
 from __future__ import annotations
 
-from roverlab.description.gazebo_specs import PlanarMoveSpec, resolve_frame, resolve_topic
+from roverlab.description.gazebo_specs import (
+    PlanarMoveSpec,
+    RosControlSpec,
+    resolve_frame,
+    resolve_topic,
+)
 from roverlab.description.gazebo_values import ElementValues
 
-__all__ = ["parse_planar_move"]
+__all__ = ["parse_planar_move", "parse_ros_control"]
 
 
 def parse_planar_move(v: ElementValues) -> PlanarMoveSpec:
@@ -36,4 +42,19 @@ def parse_planar_move(v: ElementValues) -> PlanarMoveSpec:
         cmd_timeout_s=v.number("cmdTimeout", -1.0),
         publish_odometry_tf=v.flag("publishOdometryTf", True),
         robot_namespace=ns,
+    )
+
+
+def parse_ros_control(v: ElementValues) -> RosControlSpec:
+    """``libgazebo_ros_control.so``'s ``robotNamespace`` (default: the model's name, as
+    the plugin), ``controlPeriod`` (s; default every physics step) and ``robotSimType``.
+
+    Raises:
+        URDFError: a negative or non-numeric ``controlPeriod``.
+    """
+    ns = v.text("robotNamespace", v.model_name) or "/"
+    return RosControlSpec(
+        robot_namespace=ns if ns.startswith("/") else "/" + ns,
+        control_period_s=v.non_negative("controlPeriod", 0.0),
+        robot_sim_type=v.text("robotSimType", "gazebo_ros_control/DefaultRobotHWSim"),
     )

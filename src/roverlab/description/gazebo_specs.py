@@ -351,8 +351,23 @@ class ImuPluginSpec:
     robot_namespace: str = ""
 
 
+@dataclass(frozen=True, slots=True)
+class RosControlSpec:
+    """``libgazebo_ros_control.so``: ros_control's hardware interface in Gazebo. The
+    controllers it runs (diff_drive_controller, joint_state_controller) are configured on
+    the parameter server under ``robot_namespace``, not in the URDF.
+
+    ``control_period_s`` 0 means every physics step (the plugin's default).
+    """
+
+    robot_namespace: str = "/"
+    control_period_s: float = 0.0
+    robot_sim_type: str = "gazebo_ros_control/DefaultRobotHWSim"
+
+
 PluginSpec = (
     DiffDriveSpec
+    | RosControlSpec
     | PlanarMoveSpec
     | LaserPluginSpec
     | CameraPluginSpec
@@ -362,6 +377,7 @@ PluginSpec = (
 _SpecT = TypeVar(
     "_SpecT",
     DiffDriveSpec,
+    RosControlSpec,
     PlanarMoveSpec,
     LaserPluginSpec,
     CameraPluginSpec,
@@ -505,6 +521,12 @@ class GazeboExtensions:
             if isinstance(p.spec, DiffDriveSpec | PlanarMoveSpec):
                 return p.spec
         return None
+
+    @property
+    def ros_control(self) -> RosControlSpec | None:
+        """The ``libgazebo_ros_control.so`` plugin, if any."""
+        found = self.specs(RosControlSpec)
+        return found[0] if found else None
 
     @property
     def unsupported_plugins(self) -> tuple[GazeboPlugin, ...]:

@@ -298,6 +298,24 @@ def _spawn(state: LaunchState, spec: NodeSpec) -> None:
     return None
 
 
+@register("controller_manager", "spawner")
+def _spawner(state: LaunchState, spec: NodeSpec) -> None:
+    """controller_manager's spawner: the controllers it names run in the simulator (a
+    diff_drive_controller of a robot with libgazebo_ros_control.so drives it); options
+    (``--shutdown-timeout 3``, ``--namespace=ns``...) are accepted."""
+    argv = shlex.split(spec.args)
+    i = 0
+    while i < len(argv):
+        a = argv[i]
+        if a in ("--shutdown-timeout", "--timeout", "--namespace", "--controller-manager"):
+            i += 2
+            continue
+        if not a.startswith("-"):
+            state.controllers.append((spec.namespace, a))
+        i += 1
+    return None
+
+
 @register("map_server", "map_server")
 def _map_server(state: LaunchState, spec: NodeSpec) -> Node:
     argv = shlex.split(spec.args)

@@ -10,6 +10,7 @@ from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 from functools import partial
 from pathlib import Path
+from typing import Any
 
 from roverlab.core import Context, Node, QoSProfile
 from roverlab.core.executor import ClockMode
@@ -268,6 +269,24 @@ class Launch:
     """The spawned robot's warnings (urdfdom's, unsupported plugins and sensors)."""
 
 
+def _spawned_controllers(state: LaunchState) -> dict[str, Any]:
+    """The parameter tree of every controller the spawner started, nested by namespace
+    (``{"jackal_velocity_controller": {"type": ..., "linear": {"x": {...}}}}``)."""
+    tree: dict[str, Any] = {}
+    for ns, name in state.controllers:
+        prefix = f"{ns.rstrip('/')}/{name}/"
+        if not prefix.startswith("/"):
+            prefix = "/" + prefix
+        for key, value in state.params.items():
+            if key.startswith(prefix):
+                node = tree
+                parts = [p for p in prefix.split("/") if p] + key[len(prefix) :].split("/")
+                for part in parts[:-1]:
+                    node = node.setdefault(part, {})
+                node[parts[-1]] = value
+    return tree
+
+
 def build_launch(
     path: str | Path | LaunchSpec,
     args: Mapping[str, str] | None = None,
@@ -310,7 +329,11 @@ def build_launch(
         launch.simulator = SimulatorNode(
             context=context,
             scene=state.world.to_scene(),
-            robot=sim_config_from_model(robot),
+            robot=sim_config_from_model(
+                robot,
+                controllers=_spawned_controllers(state),
+                controllers_source=next(iter(state.param_sources.values()), "<parameters>"),
+            ),
             spawn=SpawnPose(x, y, yaw),
             seed=seed,
         )

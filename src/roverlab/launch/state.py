@@ -27,6 +27,8 @@ class LaunchState:
     spawns: list[tuple[Any, tuple[float, float, float], str]] = field(default_factory=list)
     spawn_urdf: str = ""
     warnings: list[str] = field(default_factory=list)
+    #: (namespace, name) of each controller controller_manager's spawner started
+    controllers: list[tuple[str, str]] = field(default_factory=list)
 
 
 NodeFactory = Callable[[LaunchState, NodeSpec], Node | None]

@@ -162,14 +162,27 @@ class _Timings:
             self.failures[key] = self.failures.get(key, 0) + 1
 
 
-def _map_for(world: World, sim: Simulation, out: Path) -> Path:
+def _map_for(
+    world: World, sim: Simulation, out: Path, points: tuple[tuple[float, float], ...] = ()
+) -> Path:
     """The world rasterised in the robot's height band (collisions and lidars), saved as
-    ``out/map.yaml``."""
+    ``out/map.yaml``; the map also covers ``points`` (a start and goal off the world's
+    geometry) with 1 m around them."""
     cfg = sim.config
     z_lo, z_hi = cfg.height_band
     for lidar in cfg.lidars:
         z_hi = max(z_hi, sim.simulator.sensor_pose(lidar.mount)[2])
-    occ, origin = world.occupancy(MAP_RESOLUTION, z_lo, z_hi)
+    bounds = None
+    if points:
+        b = world.bounds
+        xs = [b[0] - 0.5, b[2] + 0.5, *(p[0] for p in points)]
+        ys = [b[1] - 0.5, b[3] + 0.5, *(p[1] for p in points)]
+        res = MAP_RESOLUTION
+        bounds = (
+            math.floor((min(xs) - 1.0) / res) * res, math.floor((min(ys) - 1.0) / res) * res,
+            max(xs) + 1.0, max(ys) + 1.0,
+        )  # fmt: skip
+    occ, origin = world.occupancy(MAP_RESOLUTION, z_lo, z_hi, bounds=bounds)
     saved = save_map(
         out / "map",
         np.where(occ, 100, 0).astype(np.int8),

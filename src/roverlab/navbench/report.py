@@ -237,34 +237,61 @@ class BenchReport:
 _OK_COLOURS = ((31, 119, 180), (44, 160, 44), (148, 103, 189), (23, 190, 207), (140, 86, 75))
 _FAIL = (214, 39, 40)
 _CONTACT = (255, 127, 14)
+_REFERENCE = (230, 120, 200)  # pink: the reference path
 
 
-def draw(grid: BenchGrid, records: list[GoalRecord], max_px: int = 1200) -> Image.Image:
+def draw(
+    grid: BenchGrid,
+    records: list[GoalRecord],
+    max_px: int = 1200,
+    *,
+    reference: tuple[tuple[float, float], ...] | None = None,
+) -> Image.Image:
     """The map (black lethal, grey inflated to the inscribed radius, light grey unknown),
     every driven path (coloured; red for failed goals), goals as circles with a heading
-    tick (a red cross and the goal's number for failures), contacts as orange dots."""
-    h, w = grid.costs.shape
+    tick (a red cross and the goal's number for failures), contacts as orange dots, and
+    a ``reference`` path (thin grey-blue) when given. The canvas grows (white) to hold
+    every goal, start and path point that lies off the map."""
+    res = grid.resolution
+    pts = [(r.goal[0], r.goal[1]) for r in records] + [(r.start[0], r.start[1]) for r in records]
+    pts += [(float(x), float(y)) for r in records for x, y in r.path]
+    pts += list(reference or ())
+    h0, w0 = grid.costs.shape
+    ox, oy = grid.origin
+    xs = [ox, ox + w0 * res, *(p[0] for p in pts)]
+    ys = [oy, oy + h0 * res, *(p[1] for p in pts)]
+    margin = 0.5
+    pad_l = max(0, math.ceil((ox - (min(xs) - margin)) / res)) if min(xs) < ox else 0
+    pad_b = max(0, math.ceil((oy - (min(ys) - margin)) / res)) if min(ys) < oy else 0
+    right = ox + w0 * res
+    top = oy + h0 * res
+    pad_r = max(0, math.ceil((max(xs) + margin - right) / res)) if max(xs) > right else 0
+    pad_t = max(0, math.ceil((max(ys) + margin - top) / res)) if max(ys) > top else 0
+    costs = np.pad(grid.costs, ((pad_b, pad_t), (pad_l, pad_r)), constant_values=0)
+    origin = (ox - pad_l * res, oy - pad_b * res)
+    h, w = costs.shape
     scale = max(1, min(8, max_px // max(h, w)))
     base = np.full((h, w, 3), 255, dtype=np.uint8)
-    base[grid.costs >= 253] = (200, 200, 200)
-    base[grid.costs == 254] = (0, 0, 0)
-    base[grid.costs == 255] = (225, 225, 225)
+    base[costs >= 253] = (200, 200, 200)
+    base[costs == 254] = (0, 0, 0)
+    base[costs == 255] = (225, 225, 225)
     img = Image.fromarray(base[::-1]).resize((w * scale, h * scale), Image.Resampling.NEAREST)
     d = ImageDraw.Draw(img)
-    res = grid.resolution
 
     def px(x: float, y: float) -> tuple[float, float]:
         return (
-            (x - grid.origin[0]) / res * scale,
-            (h - (y - grid.origin[1]) / res) * scale,
+            (x - origin[0]) / res * scale,
+            (h - (y - origin[1]) / res) * scale,
         )
 
     rad = max(3.0, 0.1 / res * scale)
+    if reference is not None and len(reference) > 1:
+        d.line([px(x, y) for x, y in reference], fill=_REFERENCE, width=max(1, scale // 3))
     for r in records:
         colour = _OK_COLOURS[r.index % len(_OK_COLOURS)] if r.succeeded else _FAIL
-        pts = [px(x, y) for x, y in r.path]
-        if len(pts) > 1:
-            d.line(pts, fill=colour, width=max(1, scale // 2))
+        pts_px = [px(x, y) for x, y in r.path]
+        if len(pts_px) > 1:
+            d.line(pts_px, fill=colour, width=max(1, scale // 2))
     for r in records:
         gx, gy = px(r.goal[0], r.goal[1])
         tip = px(r.goal[0] + 0.25 * math.cos(r.goal[2]), r.goal[1] + 0.25 * math.sin(r.goal[2]))

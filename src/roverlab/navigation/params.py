@@ -4,9 +4,10 @@ Every planner, controller and costmap layer keeps its parameters in a frozen, ke
 dataclass whose fields carry the ROS names and defaults. :func:`build_params` makes one from
 a ``<param>`` / ``rosparam`` mapping: numbers are converted as the ROS parameter server does
 (an int for a double, an integral float for an int), a value of the wrong type or an
-unknown name is a :class:`~roverlab.navigation.errors.NavigationParamsError` naming it
-(with a "did you mean" hint), and names a ROS package renamed are taken under their new
-name with a warning, as ``nav_core::warnRenamedParameter`` does.
+a value of the wrong type is a :class:`~roverlab.navigation.errors.NavigationParamsError`
+naming it; an unknown name is a warning naming it (with a "did you mean" hint) and is
+otherwise ignored, as ROS ignores a parameter no plugin reads; names a ROS package renamed
+are taken under their new name with a warning, as ``nav_core::warnRenamedParameter`` does.
 """
 
 from __future__ import annotations
@@ -19,7 +20,14 @@ from typing import Any, TypeVar
 
 from roverlab.navigation.errors import NavigationParamsError
 
-__all__ = ["ParamsResult", "build_params", "check", "flatten_ros", "is_number"]
+__all__ = [
+    "ParamsResult",
+    "build_params",
+    "check",
+    "flatten_ros",
+    "is_number",
+    "unknown_warning",
+]
 
 T = TypeVar("T")
 
@@ -78,6 +86,14 @@ def _coerce(where: str, name: str, annotation: str, value: Any) -> Any:
     return value  # structured values are checked by the dataclass itself
 
 
+def unknown_warning(where: str, key: str, known: Iterable[str]) -> str:
+    """The warning for a parameter nothing reads: its name, a "did you mean" hint, and
+    that it is ignored (ROS ignores parameters no plugin reads)."""
+    near = difflib.get_close_matches(key, list(known), n=1)
+    hint = f" (did you mean {near[0]}?)" if near else ""
+    return f"{where}: unknown parameter {key!r}{hint} is ignored"
+
+
 @dataclasses.dataclass(frozen=True, slots=True)
 class ParamsResult:
     """What :func:`build_params` read besides the parameters: lines to log as warnings."""
@@ -109,7 +125,8 @@ def build_params(
         The instance and the warnings.
 
     Raises:
-        NavigationParamsError: an unknown name or a value of the wrong type or range.
+        NavigationParamsError: a value of the wrong type or range (an unknown name is a
+            warning).
     """
     fields = {f.name: f for f in dataclasses.fields(cls)}  # type: ignore[arg-type]
     renamed = dict(renamed or {})
@@ -133,9 +150,9 @@ def build_params(
             continue
         field = fields.get(name)
         if field is None or not field.init:
-            near = difflib.get_close_matches(key, list(fields) + list(renamed), n=1)
-            hint = f" (did you mean {near[0]}?)" if near else ""
-            raise NavigationParamsError(f"{where}: unknown parameter {key!r}{hint}")
+            known = [f for f, fd in fields.items() if fd.init] + list(renamed)
+            warnings.append(unknown_warning(where, key, known))
+            continue
         kwargs[name] = _coerce(where, key, str(field.type), value)
     try:
         return cls(**kwargs), ParamsResult(tuple(warnings))

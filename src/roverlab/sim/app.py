@@ -11,10 +11,12 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
+import yaml
+
 from roverlab.core import Context
 from roverlab.description import RobotModel, find_package, load_robot
 from roverlab.description.node import JointStatePublisher, RobotStatePublisher
-from roverlab.errors import RoverlabError
+from roverlab.errors import RoverlabError, yaml_reason
 from roverlab.sim.config import DiffDriveConfig
 from roverlab.sim.node import SimulatorNode, SpawnPose
 from roverlab.sim.robot import sim_config_from_model
@@ -27,6 +29,12 @@ BUNDLED_ROBOTS: dict[str, tuple[str, str]] = {
     "mbot": ("mbot_description", "urdf/mbot_with_laser_gazebo.xacro"),
     "mybot": ("bingda_tutorials", "urdf/mybot.xacro"),
     "mycar": ("mycar", "urdf/xacro/car.urdf.xacro"),
+    "jackal": ("jackal_description", "urdf/jackal.urdf.xacro"),
+}
+# name -> (package, file): the ros_control controllers' YAML a bundled robot loads (what
+# its control.launch puts on the parameter server)
+BUNDLED_CONTROLLERS: dict[str, tuple[str, str]] = {
+    "jackal": ("jackal_control", "config/control.yaml"),
 }
 
 
@@ -48,6 +56,15 @@ def resolve_robot(name_or_path: str) -> Path:
     return path
 
 
+def _controllers_yaml(path: Path) -> Any:
+    try:
+        return yaml.safe_load(path.read_text())
+    except OSError as err:
+        raise SimulationError(f"{path}: cannot read: {err.strerror}") from err
+    except yaml.YAMLError as err:
+        raise SimulationError(f"{path}: {yaml_reason(err)}") from err
+
+
 @dataclass
 class Simulation:
     """The nodes of one simulated robot in one world, in ``context``.
@@ -63,6 +80,9 @@ class Simulation:
             the most expensive sensor; switch it off for fast batch runs).
         parameters: parameters of the ``gazebo`` node (``physics_rate``, ``wheel_slip``,
             ``ground_truth_rate``, ...), as ``<param>`` lines in a launch file.
+        controllers: a ros_control controllers' YAML file for a robot with
+            ``libgazebo_ros_control.so`` (default: the bundled robot's own, e.g.
+            jackal_control's ``control.yaml``).
     """
 
     context: Context
@@ -73,6 +93,7 @@ class Simulation:
     robot_args: dict[str, str] = field(default_factory=dict)
     cameras: bool = True
     parameters: dict[str, Any] = field(default_factory=dict)
+    controllers: Path | None = None
 
     def __post_init__(self) -> None:
         for v in (self.spawn.x, self.spawn.y, self.spawn.yaw):
@@ -84,7 +105,14 @@ class Simulation:
         else:
             path = resolve_robot(str(self.robot))
             self.robot_model = load_robot(path, args=self.robot_args)
-        self.config = sim_config_from_model(self.robot_model)
+        control = self.controllers
+        if control is None and str(self.robot) in BUNDLED_CONTROLLERS:
+            pkg, rel = BUNDLED_CONTROLLERS[str(self.robot)]
+            control = find_package(pkg) / rel
+        tree = _controllers_yaml(Path(control)) if control is not None else None
+        self.config = sim_config_from_model(
+            self.robot_model, controllers=tree, controllers_source=str(control)
+        )
         if not self.cameras:
             self.config = replace(self.config, cameras=(), depth_cameras=())
         self.scene = self.world_model.to_scene()

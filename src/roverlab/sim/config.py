@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
@@ -15,6 +16,9 @@ from numpy.typing import NDArray
 from roverlab.geometry import Transform3
 from roverlab.sim.diff_drive import DiffDriveParams
 from roverlab.sim.sensors import CameraParams, ImuNoise, LidarParams
+
+if TYPE_CHECKING:
+    from roverlab.sim.ros_control import DiffDriveControllerConfig
 
 __all__ = [
     "CameraSensor",
@@ -151,13 +155,14 @@ class RobotSimConfig:
 
     ``footprint`` is the body's outline on the floor (body frame, (K, 2), convex) and
     ``height_band`` the z range it occupies; ``base_frame`` is the frame the drive moves.
-    ``drive`` is a differential (or skid-steer) drive, a holonomic planar move, or None.
+    ``drive`` is a differential (or skid-steer) drive, a holonomic planar move, ros_control's
+    diff_drive_controller, or None.
     """
 
     name: str
     footprint: NDArray[np.float64]
     height_band: tuple[float, float]
-    drive: DiffDriveConfig | PlanarMoveConfig | None
+    drive: DiffDriveConfig | PlanarMoveConfig | DiffDriveControllerConfig | None
     lidars: tuple[LidarSensor, ...] = ()
     imus: tuple[ImuSensor, ...] = ()
     cameras: tuple[CameraSensor, ...] = ()

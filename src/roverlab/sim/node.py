@@ -65,7 +65,9 @@ from roverlab.sim.dynamics import (
     advance_packed,
     compiled_entry,
 )
+from roverlab.sim.odometry import publish_planar_odometry
 from roverlab.sim.planar_move import PlanarMovePlugin
+from roverlab.sim.ros_control import DiffDriveControllerConfig, DiffDriveControllerPlugin
 from roverlab.sim.sensors import CameraModel, ImuModel, LidarModel
 from roverlab.tf import TransformBroadcaster
 
@@ -164,7 +166,10 @@ class SimulatorNode(Node):
         self.drive = robot.drive
         d = self.drive if isinstance(self.drive, DiffDriveConfig) else None
         # the node's wheel_slip parameter sets the drive's slip (DiffDriveParams validates)
-        p = replace(d.params if d else DiffDriveParams(1.0, 1.0), slip_stddev=self.wheel_slip)
+        wheels = self.drive if isinstance(self.drive, DiffDriveControllerConfig) else d
+        p = replace(
+            wheels.params if wheels else DiffDriveParams(1.0, 1.0), slip_stddev=self.wheel_slip
+        )
         self._params = np.array(
             [
                 p.wheel_separation_m,
@@ -198,6 +203,12 @@ class SimulatorNode(Node):
             self.planar_move = PlanarMovePlugin(
                 node=self, config=self.drive, state=self._state, advance=self.advance,
                 tf_publisher=self._tf_pub,
+            )  # fmt: skip
+        self.controller = None
+        if isinstance(self.drive, DiffDriveControllerConfig):  # gazebo_ros_control
+            self.controller = DiffDriveControllerPlugin(
+                node=self, config=self.drive, state=self._state, advance=self.advance,
+                tf_publisher=self._tf_pub, physics_period_s=self._dt,
             )  # fmt: skip
         if d is not None:
             self.create_subscription(mc.Twist, d.command_topic, self._on_cmd, 10)
@@ -298,6 +309,8 @@ class SimulatorNode(Node):
             st[i] = 0.0
         if self.planar_move is not None:  # its command, timeout and odometry start over
             self.planar_move.reset()
+        if self.controller is not None:
+            self.controller.reset()
 
     # ----------------------------------------------------------------- commands
     def _on_cmd(self, msg: Any) -> None:
@@ -336,23 +349,12 @@ class SimulatorNode(Node):
         else:
             x, y, yaw = st[S_X], st[S_Y], st[S_TH]
             v, w = st[S_V], st[S_W]
-        sec, nsec = divmod(ns, 1_000_000_000)
-        half = 0.5 * yaw
-        qz, qw = math.sin(half), math.cos(half)
-        frame, child = d.odometry_frame, d.robot_base_frame
-        self.odom_pub.publish(
-            build.odometry(
-                sec, nsec, frame, child, x, y, 0.0, 0.0, 0.0, qz, qw, self._pose_cov,
-                v, 0.0, 0.0, 0.0, 0.0, w, self._twist_cov,
-            )
+        publish_planar_odometry(
+            self.odom_pub, self._tf_pub if d.publish_odom_tf else None, ns,
+            d.odometry_frame, d.robot_base_frame, (x, y, yaw), (v, 0.0, w),
+            self._pose_cov, self._twist_cov,
         )  # fmt: skip
-        # the transform is built only when someone reads /tf (here or in another process)
-        if d.publish_odom_tf and self._tf_pub.has_listeners:
-            self._tf_pub.publish(
-                build.tf_message(
-                    [build.transform_stamped(sec, nsec, frame, child, x, y, 0.0, 0.0, 0.0, qz, qw)]
-                )
-            )
+        sec, nsec = divmod(ns, 1_000_000_000)
         if self.joint_pub is not None:
             # one buffer for position, velocity (wheel surface speed / radius) and effort
             k = self._wheel_k

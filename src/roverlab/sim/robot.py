@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -36,9 +38,17 @@ from roverlab.sim.config import (
     RobotSimConfig,
 )
 from roverlab.sim.diff_drive import DiffDriveParams
+from roverlab.sim.ros_control import (
+    DIFF_DRIVE_CONTROLLER,
+    DiffDriveControllerConfig,
+    diff_drive_controller_config,
+)
 from roverlab.sim.sensors import CameraParams, ImuNoise, LidarParams
 
 __all__ = ["sim_config_from_model"]
+
+# the controller types driven as diff_drive_controller (Jackal's own fork has its names)
+CONTROLLER_TYPES = (DIFF_DRIVE_CONTROLLER, "jackal_diff_drive_controller/DiffDriveController")
 
 F64 = NDArray[np.float64]
 
@@ -143,15 +153,55 @@ def _rate(plugin_rate: float, sensor_rate: float, default: float) -> float:
     return default
 
 
-def sim_config_from_model(model: RobotModel) -> RobotSimConfig:
+def _controller(
+    model: RobotModel, controllers: Mapping[str, Any] | None, source: str
+) -> DiffDriveControllerConfig | None:
+    """The first diff_drive_controller among ``controllers`` (the parameter tree of
+    gazebo_ros_control's namespace: controller name -> its parameters), when the robot
+    has ``libgazebo_ros_control.so``."""
+    rc = model.gazebo.ros_control
+    if rc is None or not controllers:
+        return None
+    ns = rc.robot_namespace.strip("/")
+    tree: Any = controllers
+    for part in ns.split("/") if ns else ():
+        tree = tree.get(part, {}) if isinstance(tree, Mapping) else {}
+    for name, params in tree.items() if isinstance(tree, Mapping) else ():
+        if isinstance(params, Mapping) and params.get("type") in CONTROLLER_TYPES:
+            return diff_drive_controller_config(
+                model, str(name), params, namespace=rc.robot_namespace,
+                control_period_s=rc.control_period_s, source=source,
+            )  # fmt: skip
+    return None
+
+
+def sim_config_from_model(
+    model: RobotModel,
+    *,
+    controllers: Mapping[str, Any] | None = None,
+    controllers_source: str = "<parameters>",
+) -> RobotSimConfig:
     """Body outline, drive and sensors of a robot, as its Gazebo plugins configure them.
+
+    ``controllers``: the parameter tree ros_control reads (as a ``control.yaml`` loaded
+    at the root: ``{"jackal_velocity_controller": {"type": ..., ...}}``); a robot with
+    ``libgazebo_ros_control.so`` and a ``diff_drive_controller/DiffDriveController`` in
+    its namespace is driven by it.
 
     Raises:
         DescriptionError: a sensor or plugin refers to something the model lacks.
+        RosControlError: a controller configuration the controller would refuse.
     """
     gz = model.gazebo
+    controller = _controller(model, controllers, controllers_source)
     plugin = gz.drive
-    base = plugin.robot_base_frame if plugin is not None else model.root_link
+    base = (
+        controller.robot_base_frame
+        if controller is not None and plugin is None
+        else plugin.robot_base_frame
+        if plugin is not None
+        else model.root_link
+    )
     if base not in model.links:
         kind = "planar move" if isinstance(plugin, PlanarMoveSpec) else "diff drive"
         raise DescriptionError(
@@ -159,8 +209,10 @@ def sim_config_from_model(model: RobotModel) -> RobotSimConfig:
         )
     points = _body_points(model, base)
     zs = points[:, 2] if len(points) else np.array([0.0, 0.3])
-    drive: DiffDriveConfig | PlanarMoveConfig | None = None
-    if isinstance(plugin, PlanarMoveSpec):
+    drive: DiffDriveConfig | PlanarMoveConfig | DiffDriveControllerConfig | None = None
+    if plugin is None and controller is not None:
+        drive = controller
+    elif isinstance(plugin, PlanarMoveSpec):
         drive = PlanarMoveConfig(
             command_topic=plugin.command_topic,
             odometry_topic=plugin.odometry_topic,

@@ -338,11 +338,18 @@ def test_amcl_from_a_launch_file(tmp_path: Path) -> None:
     assert math.hypot(est.x - START.x, est.y - START.y) < 0.1
     bad = tmp_path / "bad.launch"
     bad.write_text('<launch><node pkg="amcl" type="amcl" name="amcl">'
-                   '<param name="laser_model_type" value="sonar"/></node></launch>')  # fmt: skip
+                   '<param name="odom_model_type" value="ackermann"/></node></launch>')  # fmt: skip
     with pytest.raises(
-        LaunchError, match=r"bad\.launch.*amcl/amcl.*laser_model_type must be one of"
+        LaunchError, match=r"bad\.launch.*amcl/amcl.*odom_model_type must be one of"
     ):
         build_launch(bad, context=Context())
+    # an unknown laser model: amcl warns and uses likelihood_field
+    sonar = tmp_path / "sonar.launch"
+    sonar.write_text('<launch><node pkg="amcl" type="amcl" name="amcl">'
+                     '<param name="laser_model_type" value="sonar"/></node></launch>')  # fmt: skip
+    (node,) = [n for n in build_launch(sonar, context=Context()).nodes
+               if isinstance(n, AmclNode)]  # fmt: skip
+    assert node.params.laser_model_type == "likelihood_field"
 
 
 def test_seeded_node_runs_repeat(tmp_path: Path) -> None:
@@ -360,3 +367,16 @@ def test_seeded_node_runs_repeat(tmp_path: Path) -> None:
 
     assert run(3) == run(3)
     assert run(3) != run(4)
+
+
+def test_std_warn_levels_warn_about_a_wide_estimate(caplog: pytest.LogCaptureFixture) -> None:
+    """amcl's standard deviation diagnostic ("Too large" past std_warn_level_*)."""
+    ctx = Context()
+    node = AmclNode(ctx, parameter_overrides={"std_warn_level_x": 0.1})
+    with caplog.at_level(logging.WARNING):
+        node._warn_spread(np.diag([0.01, 0.01, 0.001]))  # 0.1, 0.1, 0.03: within
+        assert "Standard deviation" not in caplog.text
+        node._warn_spread(np.diag([0.04, 0.01, 0.04]))  # x 0.2 and yaw 0.2 are not
+    assert "x 0.200 > std_warn_level_x 0.1, yaw 0.200 > std_warn_level_yaw 0.1" in caplog.text
+    assert "y 0.100" not in caplog.text
+    ctx.shutdown()

@@ -67,7 +67,6 @@ def test_from_ros_coerces_numbers_and_drops_ignored_names() -> None:
             "unknown amcl parameter 'laser_z_hti' (did you mean 'laser_z_hit'?)",
         ),
         ({"min_particles": 600, "max_particles": 500}, "min_particles <= max_particles"),
-        ({"laser_model_type": "likelihood"}, "laser_model_type must be one of"),
         ({"odom_model_type": "ackermann"}, "odom_model_type must be one of"),
         ({"kld_err": 0.0}, "kld_err must be in (0, 1)"),
         ({"resample_interval": 0}, "resample_interval must be >= 1"),
@@ -81,6 +80,21 @@ def test_bad_parameters_are_one_clear_error(params: dict[str, object], message: 
     with pytest.raises(AmclParamsError) as err:
         AmclParams.from_ros(params)
     assert message in str(err.value)
+
+
+def test_an_unknown_laser_model_is_a_warning_and_likelihood_field_as_amcl_does() -> None:
+    warnings: list[str] = []
+    p = AmclParams.from_ros({"laser_model_type": "likelihood"}, warnings=warnings)
+    assert p.laser_model_type == "likelihood_field"
+    assert warnings == [
+        'Unknown laser model type "likelihood"; defaulting to likelihood_field model'
+    ]
+    with pytest.raises(AmclParamsError, match="laser_model_type must be one of"):
+        AmclParams(laser_model_type="likelihood")
+    levels = AmclParams.from_ros({"std_warn_level_x": 0.3, "std_warn_level_yaw": 0.05})
+    assert (levels.std_warn_level_x, levels.std_warn_level_y, levels.std_warn_level_yaw) == (
+        0.3, 0.2, 0.05,
+    )  # fmt: skip
 
 
 def test_fields_are_keyword_only() -> None:

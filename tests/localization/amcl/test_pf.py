@@ -42,8 +42,13 @@ def test_a_tight_cloud_keeps_few_particles_a_wide_one_many() -> None:
     pf.init_gaussian((2.6, 2.1, 0.3), np.diag([1e-4, 1e-4, 1e-4]))  # well inside one bin
     assert pf.count == 5000
     pf.resample()
-    # one or two bins: 100 (min_particles) + 1 ... unless every draw stays in one bin
-    assert pf.count <= 101 or pf.count == 5000
+    assert pf.count == 5000  # amcl: a single occupied bin keeps max_particles
+    # astride a bin edge (x = 2.5 m, bins 0.5 m): two bins, KLD's 100 for k = 2, and amcl
+    # draws until the count exceeds the limit: 101
+    two = _pf()
+    two.init_gaussian((2.5, 2.1, 0.3), np.diag([1e-4, 1e-8, 1e-8]))
+    two.resample()
+    assert two.count == 101
     wide = _pf()
     wide.resample()  # uniform over the room: thousands of bins
     assert wide.count == 5000

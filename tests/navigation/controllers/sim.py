@@ -40,9 +40,18 @@ def field_world(seed: int, size_m: float = 6.0, boxes: int = 7) -> np.ndarray:
     return g
 
 
-def costmaps(grid: np.ndarray, local_m: float = 3.0) -> tuple[LayeredCostmap, LayeredCostmap]:
-    common = {"robot_radius": ROBOT_RADIUS, "footprint_padding": 0.0}
-    infl = {"inflation_radius": 0.45, "cost_scaling_factor": 5.0}
+def costmaps(
+    grid: np.ndarray,
+    local_m: float = 3.0,
+    *,
+    footprint: Any = None,
+    padding: float = 0.0,
+    inflation_radius: float = 0.45,
+) -> tuple[LayeredCostmap, LayeredCostmap]:
+    common: dict[str, Any] = {"robot_radius": ROBOT_RADIUS, "footprint_padding": padding}
+    if footprint is not None:
+        common["footprint"] = footprint
+    infl = {"inflation_radius": inflation_radius, "cost_scaling_factor": 5.0}
     g, _ = CostmapParams.from_ros(
         {**common, "plugins": [STATIC, INFLATION], "inflation_layer": infl}
     )
@@ -75,6 +84,22 @@ def collides(grid: np.ndarray, pose: SE2, radius: float = ROBOT_RADIUS) -> bool:
     return bool(np.any(occ & (np.hypot(nx - pose.x, ny - pose.y) < radius)))
 
 
+def collides_polygon(grid: np.ndarray, pose: SE2, body: Any) -> bool:
+    """Whether the polygon ``body`` at ``pose`` covers an occupied cell (outline and
+    inside, sampled at a quarter cell)."""
+    fp = np.asarray(body, dtype=np.float64)
+    lo, hi = fp.min(axis=0), fp.max(axis=0)
+    xs, ys = np.meshgrid(
+        np.arange(lo[0], hi[0] + 1e-9, RES / 4), np.arange(lo[1], hi[1] + 1e-9, RES / 4)
+    )
+    c, s = math.cos(pose.theta), math.sin(pose.theta)
+    wx = pose.x + xs * c - ys * s
+    wy = pose.y + xs * s + ys * c
+    cx, cy = (wx / RES).astype(int), (wy / RES).astype(int)
+    ok = (cx >= 0) & (cy >= 0) & (cx < grid.shape[1]) & (cy < grid.shape[0])
+    return bool((~ok).any() or (grid[cy[ok], cx[ok]] == 100).any())
+
+
 @dataclass
 class Run:
     reached: bool
@@ -96,9 +121,17 @@ def run(
     dt: float = 0.1,
     max_steps: int = 1500,
     local_m: float = 3.0,
+    body: Any = None,
+    padding: float = 0.0,
+    inflation_radius: float = 0.45,
 ) -> Run:
-    """Drive ``controller`` from ``start`` to ``goal`` (plan by navfn on the global costmap)."""
-    glob, local = costmaps(grid, local_m)
+    """Drive ``controller`` from ``start`` to ``goal`` (plan by navfn on the global costmap).
+
+    ``body``: the robot's polygon (None: a disc of :data:`ROBOT_RADIUS`), padded by
+    ``padding`` in the costmaps; a collision is the body touching an occupied cell."""
+    glob, local = costmaps(
+        grid, local_m, footprint=body, padding=padding, inflation_radius=inflation_radius
+    )
     plan = NavfnPlanner().plan(start, goal, glob.costmap)
     pose, twist = start, Velocity2D()
     out = Run(False, False, 0, pose)
@@ -123,7 +156,7 @@ def run(
             pose.y + vx * math.sin(pose.theta) * dt,
             pose.theta + wz * dt,
         )
-        out.collided |= collides(grid, pose)
+        out.collided |= collides(grid, pose) if body is None else collides_polygon(grid, pose, body)
         out.steps = step + 1
     out.pose = pose
     return out

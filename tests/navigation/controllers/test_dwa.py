@@ -82,8 +82,12 @@ def test_escape_from_a_lethal_cell_under_the_footprint(dwa_params: DWAParams) ->
     assert footprint_cost(cm.costs, 0.05, 0.0, 0.0, 1.5, 1.5, 0.0, fp, 1.0, buf) < 0
     dwa = DWAPlanner(dwa_params, footprint=fp)
     cmd = dwa.compute_velocity(pose, Velocity2D(), plan, cm)
-    assert cmd.vx > 0.0  # on along the plan, away from the cell
-    assert len(dwa.trajectory) > 1
+    # on along the plan, away from the cell: forward within the dynamic window (2.5 m/s^2
+    # for 0.1 s), its trajectory's last footprint clear of the cell and legal
+    assert 0.05 <= cmd.vx <= 0.25 + 1e-9 and cmd.vy == 0.0 and abs(cmd.wz) <= 0.32 + 1e-9
+    x, y, th = dwa.trajectory[-1]
+    assert x > 1.5 + 0.5 * cmd.vx and not dwa.escaping
+    assert footprint_cost(cm.costs, 0.05, 0.0, 0.0, x, y, th, fp, 1.0, buf) >= 0
     # walled in ahead and behind: no sample gets clear without crossing other lethal cells
     boxed = cm.copy()
     boxed.costs[:, int(1.75 / 0.05)] = 254
@@ -100,7 +104,9 @@ def test_rotate_in_place_at_the_goal_then_reached(dwa_params: DWAParams) -> None
     cmd = dwa.compute_velocity(pose, Velocity2D(0.2, 0.0, 0.0), plan, cm)
     assert cmd.vx == pytest.approx(0.0) and cmd.wz == 0.0  # braking first
     cmd = dwa.compute_velocity(pose, Velocity2D(), plan, cm)
-    assert cmd.vx == 0.0 and cmd.wz > 0.0  # then turning towards the goal's yaw
+    # then turning towards the goal's yaw: from rest the acceleration allows 0.32 rad/s in
+    # 0.1 s, raised to min_vel_theta (LatchedStopRotateController's order of clamps)
+    assert cmd == Velocity2D(0.0, 0.0, pytest.approx(0.4))
     assert not dwa.is_goal_reached(pose, Velocity2D())
     at_goal = SE2(1.5, 1.5, 1.15)
     assert not dwa.is_goal_reached(at_goal, Velocity2D(0.0, 0.0, 0.5))  # still turning
@@ -153,8 +159,9 @@ def test_parameters_renamed_and_validated() -> None:
     assert any("vy_samples" in w for w in warnings)
     with pytest.raises(NavigationParamsError, match="sim_time must be > 0"):
         DWAParams.from_ros({"sim_time": 0})
-    with pytest.raises(NavigationParamsError, match="unknown parameter 'max_vel_xx'"):
-        DWAParams.from_ros({"max_vel_xx": 1.0})
+    unknown, warnings = DWAParams.from_ros({"max_vel_xx": 1.0})
+    assert unknown == DWAParams()
+    assert any("unknown parameter 'max_vel_xx' (did you mean max_vel_x?)" in w for w in warnings)
     with pytest.raises(NavigationParamsError, match="acc_lim_x must be a finite number"):
         DWAParams.from_ros({"acc_lim_x": "fast"})
 
@@ -170,5 +177,26 @@ def test_trajectory_planner_ros_names_map_onto_dwa() -> None:
     assert any("heading_lookahead" in w for w in warnings)
     holo, _ = DWAParams.from_trajectory_planner_ros({})
     assert holo.y_limits == (-0.3, 0.3) and holo.vy_samples == 4
-    with pytest.raises(NavigationParamsError, match="unknown parameter"):
-        DWAParams.from_trajectory_planner_ros({"max_vel_z": 1.0})
+    z, warnings = DWAParams.from_trajectory_planner_ros({"max_vel_z": 1.0})
+    assert z == holo and any("unknown parameter 'max_vel_z'" in w for w in warnings)
+
+
+def test_trajectory_planner_ros_escape_and_deprecated_names() -> None:
+    """BARN's base_local_planner_params.yaml: escape_* are applied, heading_* named."""
+    p, warnings = DWAParams.from_trajectory_planner_ros(
+        {"escape_vel": -0.5, "escape_reset_dist": 0.2, "escape_reset_theta": 0.3,
+         "heading_lookahead": 0.325, "heading_scoring": True, "simple_attractor": False,
+         "min_in_place_rotational_vel": 0.3, "odom_topic": "odometry/filtered",
+         "world_model": "voxel", "restore_defaults": False}
+    )  # fmt: skip
+    assert (p.escape_vel, p.escape_reset_dist, p.escape_reset_theta) == (-0.5, 0.2, 0.3)
+    assert p.min_vel_theta == 0.3
+    text = "\n".join(warnings)
+    assert "min_in_place_rotational_vel has been renamed to min_in_place_vel_theta" in text
+    assert "heading_lookahead has no effect" in text and "heading_scoring true" in text
+    assert "world_model 'voxel'" in text and "simple_attractor" not in text
+    assert "odom_topic" not in text and "restore_defaults" not in text
+    old, warnings = DWAParams.from_trajectory_planner_ros({"backup_vel": -0.2})
+    assert old.escape_vel == -0.2 and any("backup_vel has been renamed" in w for w in warnings)
+    with pytest.raises(NavigationParamsError, match="escape_vel must be <= 0"):
+        DWAParams.from_trajectory_planner_ros({"escape_vel": 0.5})

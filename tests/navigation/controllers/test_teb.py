@@ -6,11 +6,12 @@ import math
 
 import numpy as np
 import pytest
+from scipy.spatial import cKDTree
 
 from roverlab.geometry import SE2
 from roverlab.navigation.controllers import FootprintModel, TebParams, TebPlanner, Velocity2D
 from roverlab.navigation.controllers.teb import TimedElasticBand
-from roverlab.navigation.controllers.teb.kernels import robot_distance
+from roverlab.navigation.controllers.teb.kernels import associate_obstacles, robot_distance
 from roverlab.navigation.costmap import Costmap2D, footprint_from_radius
 from roverlab.navigation.errors import NavigationParamsError, NoValidControlError
 from roverlab.navigation.planners import NavfnPlanner
@@ -70,12 +71,26 @@ def test_parameters_validation_and_unimplemented_names() -> None:
     p, warnings = TebParams.from_ros(
         {**TEB, "enable_homotopy_class_planning": True, "max_vel_x_backwards": 0.0}
     )
-    assert any("enable_homotopy_class_planning is not implemented" in w for w in warnings)
+    assert any("homotopy class planning is not implemented" in w for w in warnings)
     assert any("max_vel_x_backwards to be <= 0" in w for w in warnings)
-    with pytest.raises(NavigationParamsError, match="max_vel_y must be 0"):
-        TebParams.from_ros({"max_vel_y": 0.2})
-    with pytest.raises(NavigationParamsError, match="unknown parameter 'dt_reff'"):
-        TebParams.from_ros({"dt_reff": 0.3})
+    # teb's default is homotopy planning on: a user who never set it is told too
+    _, silent = TebParams.from_ros({"enable_homotopy_class_planning": False})
+    _, told = TebParams.from_ros({})
+    assert silent == () and any("enable_homotopy_class_planning is true" in w for w in told)
+    holo, warnings = TebParams.from_ros({"max_vel_y": 0.2, "enable_homotopy_class_planning": False})
+    assert holo.max_vel_y == 0.0 and any("max_vel_y 0.2 ignored" in w for w in warnings)
+    misspelt, warnings = TebParams.from_ros(
+        {"dt_reff": 0.3, "enable_homotopy_class_planning": False, "odom_topic": "odom",
+         "max_number_classes": 4, "obstacle_proximity_ratio_max_vel": 1.0,
+         "costmap_converter": {"CostmapToPolygonsDBSMCCH": {"cluster_max_distance": 0.4}},
+         "footprint_model": {"type": "circular", "radius": 0.2, "raduis": 0.3}}
+    )  # fmt: skip
+    assert misspelt.dt_ref == 0.3 and misspelt.footprint_model.values == (0.2,)
+    text = "\n".join(warnings)
+    assert "unknown parameter 'dt_reff' (did you mean dt_ref?)" in text
+    assert "max_number_classes" in text and "obstacle_proximity_ratio_max_vel" in text
+    assert "costmap_converter/CostmapToPolygonsDBSMCCH/cluster_max_distance" in text
+    assert "'raduis'" in text and "odom_topic" not in text
     with pytest.raises(NavigationParamsError, match="dt_hysteresis"):
         TebParams(dt_ref=0.3, dt_hysteresis=0.4)
     assert p.trans_limit == p.max_vel_x
@@ -149,3 +164,31 @@ def test_teb_is_deterministic(teb_params: TebParams) -> None:
     # the solver is compiled code without BLAS: the same bits every call
     for c in cmds[1:]:
         assert (c.vx, c.wz) == (cmds[0].vx, cmds[0].wz)
+
+
+def test_work_per_cycle_is_bounded_by_the_band_not_the_costmap(teb_params: TebParams) -> None:
+    """Issue 28: 318-378 ms cycles in BARN's dense worlds, every lethal cell a point
+    obstacle checked against every pose. The association now sees only the obstacles
+    within its reach of the band (a k-d tree) and keeps the 8 closest force-included ones
+    per pose (plus the closest left and right)."""
+    poses = np.array([[0.0, 0.0, 0.0], [0.5, 0.0, 0.0], [1.0, 0.0, 0.0]])
+    ring = np.column_stack([0.5 + 0.1 * np.cos(np.arange(40)), 0.1 * np.sin(np.arange(40))])
+    op = np.empty(200, dtype=np.int64)
+    oo = np.empty(200, dtype=np.int64)
+    cnt = associate_obstacles(poses, ring, 0, np.zeros(0), 0.5, 2.0, op, oo, 8)
+    assert cnt == 8 and (op[:cnt] == 1).all()
+    d = np.hypot(ring[:, 0] - 0.5, ring[:, 1])
+    assert set(d[oo[:cnt]]) <= set(np.sort(d)[:8])  # the closest eight
+    teb = TebPlanner(teb_params, footprint=FOOT)
+    cm = _open()
+    cm.costs[:, ::2] = 254  # a costmap full of lethal cells: 900 of them
+    teb.obstacles = teb._costmap_obstacles(SE2(0.5, 1.5, 0.0), cm)
+    teb._obstacle_tree = cKDTree(teb.obstacles)
+    band = np.column_stack([np.linspace(0.5, 1.5, 11), np.full(11, 1.5), np.zeros(11)])
+    near = teb._near_obstacles(band)
+    fp = teb_params.footprint_model
+    reach = teb_params.min_obstacle_dist * teb_params.obstacle_association_cutoff_factor
+    reach += fp.values[0] if fp.type == "circular" else 0.0
+    gaps = near[:, None, :] - band[None, 1:-1, :2]
+    dist = np.hypot(gaps[..., 0], gaps[..., 1]).min(axis=1)
+    assert 0 < len(near) < len(teb.obstacles) and (dist <= reach + 1e-9).all()

@@ -105,8 +105,8 @@ def test_costmap_node_publishes_the_costmap_updates_and_footprint() -> None:
 
 def test_bad_costmap_parameter_fails_the_node_with_its_name() -> None:
     ctx = Context()
-    with pytest.raises(NavigationParamsError, match="costmap: unknown parameter 'update_frequncy'"):
-        Costmap2DNode(ctx, parameter_overrides={"costmap/update_frequncy": 5.0})
+    with pytest.raises(NavigationParamsError, match="costmap: update_frequency must be >= 0"):
+        Costmap2DNode(ctx, parameter_overrides={"costmap/update_frequency": -5.0})
     ctx.shutdown()
 
 

@@ -27,7 +27,8 @@ from roverlab.navigation.move_base.plugins import (
 
 
 def test_defaults_are_move_base_s() -> None:
-    p = MoveBaseParams.from_ros({})
+    p, warnings = MoveBaseParams.from_ros({})
+    assert warnings == ()
     assert p.base_global_planner == "navfn/NavfnROS"
     assert p.base_local_planner == "base_local_planner/TrajectoryPlannerROS"
     assert (p.controller_frequency, p.planner_patience, p.controller_patience) == (20.0, 5.0, 15.0)
@@ -39,13 +40,13 @@ def test_defaults_are_move_base_s() -> None:
         "aggressive_reset",
         "rotate_recovery",
     ]
-    no_rotation = MoveBaseParams.from_ros({"clearing_rotation_allowed": False})
+    no_rotation, _ = MoveBaseParams.from_ros({"clearing_rotation_allowed": False})
     assert [r.name for r in no_rotation.recoveries] == ["conservative_reset", "aggressive_reset"]
     assert default_recoveries(False) == no_rotation.recoveries
 
 
 def test_launch_values_and_plugin_names() -> None:
-    p = MoveBaseParams.from_ros(
+    p, _ = MoveBaseParams.from_ros(
         {
             "base_global_planner": "global_planner/GlobalPlanner",
             "base_local_planner": "dwa_local_planner/DWAPlannerROS",
@@ -74,7 +75,6 @@ def test_launch_values_and_plugin_names() -> None:
         ({"base_local_planner": "mpc/MPC"}, "roverlab has dwa_local_planner/DWAPlannerROS"),
         ({"controller_frequency": 0}, "controller_frequency must be > 0"),
         ({"planner_patience": -1}, "planner_patience must be >= 0"),
-        ({"controler_frequency": 5}, "did you mean 'controller_frequency'"),
         ({"shutdown_costmaps": "maybe"}, "must be true or false"),
         ({"recovery_behaviors": [{"name": "x"}]}, "needs a name and a type"),
         ({"recovery_behaviors": [{"name": "x", "type": "a/B"}]}, "which is not available"),
@@ -83,6 +83,17 @@ def test_launch_values_and_plugin_names() -> None:
 def test_bad_parameters_are_one_clear_error(values: dict, needle: str) -> None:
     with pytest.raises(NavigationParamsError, match=needle):
         MoveBaseParams.from_ros(values)
+
+
+def test_an_unknown_name_is_warned_about_by_name_and_ignored() -> None:
+    p, warnings = MoveBaseParams.from_ros(
+        {"controler_frequency": 5, "make_plan_clear_costmap": False}
+    )
+    assert p.controller_frequency == 20.0 and p.make_plan_clear_costmap is False
+    assert warnings == (
+        "move_base: unknown parameter 'controler_frequency' (did you mean "
+        "controller_frequency?) is ignored",
+    )
 
 
 def test_plugins_by_ros_name() -> None:
@@ -103,13 +114,16 @@ def test_plugins_by_ros_name() -> None:
         "teb_local_planner/TebLocalPlannerROS", {}, footprint=(), controller_frequency=5.0
     )
     assert type(teb).__name__ == "TebPlanner"
-    with pytest.raises(NavigationParamsError, match="navfn"):
-        make_global_planner("navfn/NavfnROS", {"allow_unknwn": True})
+    navfn, warnings = make_global_planner("navfn/NavfnROS", {"allow_unknwn": False})
+    assert navfn.params.allow_unknown is True  # type: ignore[attr-defined]
+    assert warnings == (
+        "navfn: unknown parameter 'allow_unknwn' (did you mean allow_unknown?) is ignored",
+    )
 
 
 def test_recovery_plugins() -> None:
     limits = LocalPlannerLimits(2.0, 0.8, 0.3, 0.15)
-    clear = make_recovery(
+    clear, _ = make_recovery(
         "conservative_reset",
         "clear_costmap_recovery/ClearCostmapRecovery",
         {},
@@ -119,7 +133,7 @@ def test_recovery_plugins() -> None:
         footprint=(),
     )
     assert isinstance(clear, ClearCostmapRecovery) and clear.reset_distance == 3.0
-    rot = make_recovery(
+    rot, _ = make_recovery(
         "rotate_recovery",
         "rotate_recovery/RotateRecovery",
         {"frequency": 10.0},
@@ -137,16 +151,19 @@ def test_recovery_plugins() -> None:
         min_in_place_rotational_vel=0.3,
         tolerance=0.15,
     )
-    with pytest.raises(NavigationParamsError, match="reset_distanc"):
-        make_recovery(
-            "r",
-            "clear_costmap_recovery/ClearCostmapRecovery",
-            {"reset_distanc": 1.0},
-            default_reset_distance=3.0,
-            limits=limits,
-            trajectory_planner={},
-            footprint=(),
-        )
+    misspelt, warnings = make_recovery(
+        "r",
+        "clear_costmap_recovery/ClearCostmapRecovery",
+        {"reset_distanc": 1.0},
+        default_reset_distance=3.0,
+        limits=limits,
+        trajectory_planner={},
+        footprint=(),
+    )
+    assert misspelt.reset_distance == 3.0  # type: ignore[union-attr]
+    assert warnings == (
+        "r: unknown parameter 'reset_distanc' (did you mean reset_distance?) is ignored",
+    )
 
 
 def _costmap(obstacles: list[tuple[float, float]], rolling: bool = False):  # type: ignore[no-untyped-def]

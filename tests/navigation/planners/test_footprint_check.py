@@ -107,7 +107,7 @@ def test_colliding_poses_in_a_wall_and_near_the_ends() -> None:
 
 def test_move_base_parameter() -> None:
     assert MoveBaseParams().plan_footprint_check is True
-    assert MoveBaseParams.from_ros({"plan_footprint_check": False}).plan_footprint_check is False
+    assert MoveBaseParams.from_ros({"plan_footprint_check": False})[0].plan_footprint_check is False
 
 
 def test_plans_through_a_narrow_door_are_kept() -> None:

@@ -238,8 +238,11 @@ def test_planner_parameters_from_ros() -> None:
     assert p == NavfnParams(allow_unknown=False, default_tolerance=1.0)
     g, _ = GlobalPlannerParams.from_ros({"use_dijkstra": False, "orientation_mode": 1.0})
     assert (g.use_dijkstra, g.orientation_mode) == (False, 1)
-    with pytest.raises(NavigationParamsError, match="unknown parameter 'use_dijkstraa'"):
-        GlobalPlannerParams.from_ros({"use_dijkstraa": True})
+    g, warnings = GlobalPlannerParams.from_ros({"use_dijkstraa": False})
+    assert g.use_dijkstra is True
+    assert warnings == (
+        "global_planner: unknown parameter 'use_dijkstraa' (did you mean use_dijkstra?) is ignored",
+    )
     with pytest.raises(NavigationParamsError, match="default_tolerance must be >= 0"):
         NavfnParams.from_ros({"default_tolerance": -1.0})
 

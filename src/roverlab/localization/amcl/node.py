@@ -112,7 +112,10 @@ class AmclNode(Node):
         for f in dataclasses.fields(AmclParams):  # odom_model_type before the alphas
             default = AmclParams.default_of(f.name, str(values.get("odom_model_type", "")))
             values[f.name] = self.declare_parameter(f.name, default).value
-        self.params = AmclParams.from_ros(values)
+        warnings: list[str] = []
+        self.params = AmclParams.from_ros(values, warnings=warnings)
+        for w in warnings:
+            self.get_logger().warning(w)
         p = self.params
         self.rng = np.random.default_rng(int(self.declare_parameter("seed", 0).value))
         self.global_frame = _strip(p.global_frame_id)
@@ -418,6 +421,21 @@ class AmclNode(Node):
         )
         self.pose_publisher.publish(msg)
         self.last_pose = msg
+        self._warn_spread(estimate.covariance)
+
+    def _warn_spread(self, cov: np.ndarray) -> None:
+        """amcl's standard deviation diagnostic: "Too large" beyond ``std_warn_level_*``
+        (a throttled warning here; roverlab publishes no ``/diagnostics``)."""
+        p = self.params
+        std = np.sqrt(np.maximum(np.diag(cov)[:3], 0.0))
+        levels = (p.std_warn_level_x, p.std_warn_level_y, p.std_warn_level_yaw)
+        over = [
+            f"{name} {s:.3f} > std_warn_level_{name} {lvl:g}"
+            for name, s, lvl in zip(("x", "y", "yaw"), std, levels, strict=True)
+            if s > lvl
+        ]
+        if over:
+            self._throttle.warning("std", "Standard deviation too large: " + ", ".join(over))
 
     def _send_transform(self, stamp: Time) -> None:
         if not self.params.tf_broadcast or self._map_to_odom is None:

@@ -63,6 +63,9 @@ NODE_PARAMETERS: Final = frozenset(
         "odom_frame_id",
         "base_frame_id",
         "global_frame_id",
+        "std_warn_level_x",
+        "std_warn_level_y",
+        "std_warn_level_yaw",
     }
 )
 
@@ -159,6 +162,9 @@ class AmclParams:
     update_min_a: float = math.pi / 6.0
     resample_interval: int = 1
     transform_tolerance: float = 0.1
+    std_warn_level_x: float = 0.2
+    std_warn_level_y: float = 0.2
+    std_warn_level_yaw: float = 0.1
     recovery_alpha_slow: float = 0.0
     recovery_alpha_fast: float = 0.0
     initial_pose_x: float = 0.0
@@ -212,6 +218,8 @@ class AmclParams:
         _check(self.update_min_a >= 0.0, "update_min_a must be >= 0")
         _check(self.resample_interval >= 1, "resample_interval must be >= 1")
         _check(self.transform_tolerance >= 0.0, "transform_tolerance must be >= 0")
+        for name in ("std_warn_level_x", "std_warn_level_y", "std_warn_level_yaw"):
+            _check(getattr(self, name) >= 0.0, f"{name} must be >= 0")
         for name in ("recovery_alpha_slow", "recovery_alpha_fast"):
             _check(0.0 <= getattr(self, name) <= 1.0, f"{name} must be in [0, 1]")
         for name in ("initial_cov_xx", "initial_cov_yy", "initial_cov_aa"):
@@ -245,12 +253,16 @@ class AmclParams:
             _check(getattr(self, name) >= 0.0, f"{name} must be >= 0 (or -1: the model's default)")
 
     @classmethod
-    def from_ros(cls, params: Mapping[str, Any]) -> AmclParams:
+    def from_ros(
+        cls, params: Mapping[str, Any], *, warnings: list[str] | None = None
+    ) -> AmclParams:
         """Build from an amcl ``<param>`` set (names as in a ``.launch`` file).
 
         Integers given for float parameters are accepted (``value="1"``), and integral
         floats for integer ones; :data:`IGNORED_PARAMETERS` are dropped; any other unknown
-        name is an error naming the closest known one.
+        name is an error naming the closest known one. An unknown ``laser_model_type`` is
+        replaced by ``likelihood_field`` with a warning appended to ``warnings``, as amcl
+        does ("Unknown laser model type ...; defaulting to likelihood_field model").
 
         Raises:
             AmclParamsError: an unknown name or a bad value.
@@ -263,6 +275,13 @@ class AmclParams:
             return AmclParamsError(f"unknown amcl parameter {key!r}{hint}")
 
         kwargs = _KINDS.kwargs(params, names, ignored=IGNORED_PARAMETERS, unknown=unknown)
+        model = kwargs.get("laser_model_type")
+        if isinstance(model, str) and model not in LASER_MODELS:
+            kwargs["laser_model_type"] = "likelihood_field"
+            if warnings is not None:
+                warnings.append(
+                    f'Unknown laser model type "{model}"; defaulting to likelihood_field model'
+                )
         return cls(**kwargs)
 
     @staticmethod

@@ -139,7 +139,14 @@ class Costmap2DROS:
             def on_msg(msg: Any, source: str = src.name) -> None:
                 self._observation(layer, source, msg)
 
-            flt = TfMessageFilter(self.node, self.tf_buffer, frames, _SENSOR_QUEUE, on_msg)
+            flt = TfMessageFilter(
+                self.node,
+                self.tf_buffer,
+                frames,
+                _SENSOR_QUEUE,
+                on_msg,
+                timeout_s=layer.params.transform_tolerance,
+            )
             mtype = {
                 "LaserScan": mc.LaserScan,
                 "PointCloud2": mc.PointCloud2,

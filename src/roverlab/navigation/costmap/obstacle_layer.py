@@ -95,11 +95,15 @@ class ObstacleLayerParams:
     """The obstacle layer's parameters (ROS names and defaults).
 
     ``track_unknown_space`` None means the costmap's own setting, as costmap_2d.
+    ``transform_tolerance`` (s): how long an observation may wait for its transform before
+    it is dropped (ROS: the observation buffers' TF tolerance; None, the default here:
+    it waits as long as the queue allows, as before).
     """
 
     enabled: bool = True
     track_unknown_space: bool | None = None
     max_obstacle_height: float = 2.0
+    transform_tolerance: float | None = None
     footprint_clearing_enabled: bool = True
     combination_method: int = 1
     observation_sources: tuple[ObservationSourceParams, ...] = field(default_factory=tuple)
@@ -107,6 +111,10 @@ class ObstacleLayerParams:
     def __post_init__(self) -> None:
         names = [s.name for s in self.observation_sources]
         check(len(set(names)) == len(names), "obstacle_layer: observation source listed twice")
+        check(
+            self.transform_tolerance is None or self.transform_tolerance >= 0,
+            "obstacle_layer: transform_tolerance must be >= 0",
+        )
 
 
 @dataclass(frozen=True, slots=True)

@@ -18,8 +18,14 @@ replacing the layer's own value (costmap_2d's ``copyParentParameters``).
 :meth:`CostmapParams.from_ros` takes the parameters under the costmap's namespace as a
 flat ``{"obstacle_layer/scan/topic": ...}`` mapping (nested mappings are flattened too)
 and returns the parameters and warnings. A ``VoxelLayer`` is run as an obstacle layer (its
-voxel parameters are accepted and ignored with a warning); an unknown plugin type, an
-unknown name or a bad value is an error naming it.
+voxel parameters are accepted and ignored with a warning); an unknown plugin type or a bad
+value is an error naming it; an unknown name is a warning naming it (ROS ignores it).
+
+The obstacle layer's height filter and ranges are looked up as ROS's ``searchParam``
+does, from the source up: a source's ``min/max_obstacle_height``, ``obstacle_range`` and
+``raytrace_range`` default to the layer's, which default to the costmap's top-level ones
+(ROS 1 reads ``min_obstacle_height`` per source only; packages that set it in the costmap
+namespace, as a ROS 1 book's fake-robot demo does, get it applied here).
 """
 
 from __future__ import annotations
@@ -45,7 +51,7 @@ from roverlab.navigation.costmap.obstacle_layer import (
 )
 from roverlab.navigation.costmap.static_layer import StaticLayer, StaticLayerParams
 from roverlab.navigation.errors import NavigationParamsError
-from roverlab.navigation.params import build_params, check, flatten_ros
+from roverlab.navigation.params import build_params, check, flatten_ros, unknown_warning
 
 __all__ = ["CostmapParams", "LayerParams", "PluginSpec", "make_layered_costmap"]
 
@@ -68,7 +74,13 @@ _PARENT_KEYS = {
         "unknown_threshold",
         "publish_voxel_map",
     ),
-    OBSTACLE: ("max_obstacle_height", "raytrace_range", "obstacle_range", "track_unknown_space"),
+    OBSTACLE: (
+        "min_obstacle_height",
+        "max_obstacle_height",
+        "raytrace_range",
+        "obstacle_range",
+        "track_unknown_space",
+    ),
     INFLATION: ("cost_scaling_factor", "inflation_radius"),
 }
 _VOXEL_ONLY = frozenset(_PARENT_KEYS[VOXEL]) | {"max_obstacle_height_voxel"}
@@ -78,6 +90,8 @@ _OBSTACLE_LAYER_KEYS = frozenset(
         "enabled",
         "track_unknown_space",
         "max_obstacle_height",
+        "min_obstacle_height",
+        "transform_tolerance",
         "footprint_clearing_enabled",
         "combination_method",
         "observation_sources",
@@ -221,7 +235,7 @@ def _old_plugins(
         plugins.append(("obstacle_layer", OBSTACLE))
     else:
         raise NavigationParamsError(f"{name}: map_type must be costmap or voxel, got {map_type!r}")
-    for key in ("max_obstacle_height", "raytrace_range", "obstacle_range"):
+    for key in ("min_obstacle_height", "max_obstacle_height", "raytrace_range", "obstacle_range"):
         move("obstacle_layer", key)
     move("obstacle_layer", "track_unknown_space", delete=False)
     sources = top.get("observation_sources", "")
@@ -286,6 +300,11 @@ def _parse(flat: dict[str, Any], name: str) -> tuple[CostmapParams, tuple[str, .
         if key != "track_unknown_space":
             top.pop(key)
             warnings.append(f"{name}: parameter {key} is unused (no layer of its type)")
+    if "footprint_topic" in top:
+        warnings.append(
+            f"{name}: footprint_topic is not subscribed: roverlab has no dynamic footprint "
+            "(the footprint parameter is used)"
+        )
     params, res = build_params(CostmapParams, top, where=name, extra={"plugins": tuple(specs)})
     return params, tuple(warnings) + res.warnings
 
@@ -325,13 +344,23 @@ def _layer(
     sources_text = layer_vals.pop("observation_sources", "")
     if not isinstance(sources_text, str):
         raise NavigationParamsError(f"{where}: observation_sources must be a string of names")
-    obstacle_range = layer_vals.pop("obstacle_range", top.get("obstacle_range", 2.5))
-    raytrace_range = layer_vals.pop("raytrace_range", top.get("raytrace_range", 3.0))
+    # searchParam: the source's value, else the layer's, else the costmap's (else ROS's)
+    inherited = {
+        key: layer_vals.pop(key, top.get(key, default))
+        for key, default in (
+            ("obstacle_range", 2.5),
+            ("raytrace_range", 3.0),
+            ("min_obstacle_height", 0.0),
+        )
+    }
+    inherited["max_obstacle_height"] = layer_vals.get(
+        "max_obstacle_height", top.get("max_obstacle_height", 2.0)
+    )
     sources = []
     for src in sources_text.split():
         sv = dict(source_vals.pop(src, {}))
-        sv.setdefault("obstacle_range", obstacle_range)
-        sv.setdefault("raytrace_range", raytrace_range)
+        for key, value in inherited.items():
+            sv.setdefault(key, value)
         s, res = build_params(
             ObservationSourceParams, sv, where=f"{where}/{src}", extra={"name": src}
         )
@@ -341,9 +370,9 @@ def _layer(
         warnings.append(
             f"{where}: parameters of {src} are unused ({src} is not an observation source)"
         )
-    for key in layer_vals:
-        if key not in _OBSTACLE_LAYER_KEYS:
-            raise NavigationParamsError(f"{where}: unknown parameter {key!r}")
+    for key in sorted(set(layer_vals) - _OBSTACLE_LAYER_KEYS):
+        warnings.append(unknown_warning(where, key, _OBSTACLE_LAYER_KEYS))
+        layer_vals.pop(key)
     o, res = build_params(
         ObstacleLayerParams, layer_vals, where=where, extra={"observation_sources": tuple(sources)}
     )

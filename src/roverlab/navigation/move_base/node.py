@@ -62,8 +62,10 @@ from roverlab.navigation.move_base.plugins import (
     make_local_planner,
     make_recovery,
     plugin_short_name,
+    rotate_fallback,
 )
-from roverlab.navigation.move_base.recovery import ClearCostmapRecovery, RotateRecovery
+from roverlab.navigation.move_base.potential import PotentialPublisher
+from roverlab.navigation.move_base.recovering import Recovering
 from roverlab.navigation.node_params import parameters_under
 from roverlab.navigation.planners import Path2D, path_to_msg
 from roverlab.navigation.planners.footprint_check import plan_clear_of_footprint
@@ -137,7 +139,8 @@ class MoveBase(Node):
             for k in self.unused_parameter_overrides()
             if "/" not in k and "." not in k
         }
-        self.params = p = MoveBaseParams.from_ros(top)
+        self.params, mb_warnings = MoveBaseParams.from_ros(top)
+        p = self.params
         log = self.get_logger()
         self.tf_buffer = Buffer()
         self.tf_listener = TransformListener(self.tf_buffer, self)
@@ -149,17 +152,20 @@ class MoveBase(Node):
             p.base_global_planner, parameters_under(self, gname)
         )
         lname = plugin_short_name(p.base_local_planner)
+        lvalues = parameters_under(self, lname)
+        body = self.local_costmap.params.unpadded_footprint()
         self.controller, limits, w2 = make_local_planner(
             p.base_local_planner,
-            parameters_under(self, lname),
+            lvalues,
             footprint=self.local_costmap.footprint,
+            body_footprint=body,
             controller_frequency=p.controller_frequency,
         )
-        for w in (*warnings, *w2):
+        for w in (*mb_warnings, *warnings, *w2):
             log.warning(w)
         _inscribed, circumscribed = footprint_radii(self.global_costmap.footprint)
         tp = parameters_under(self, "TrajectoryPlannerROS")
-        self.recoveries = [
+        made = [
             make_recovery(
                 r.name,
                 r.type,
@@ -172,9 +178,14 @@ class MoveBase(Node):
                 limits=limits,
                 trajectory_planner=tp,
                 footprint=self.local_costmap.footprint,
+                body_footprint=body,
             )
             for r in p.recoveries
         ]
+        self.recoveries = [rec for rec, _ in made]
+        for _, rw in made:
+            for w in rw:
+                log.warning(w)
         # parameters of the planners not in use (a launch file loads both dwa and teb files,
         # as seed 003's does): ROS keeps them on the parameter server unread; so do we
         idle = {plugin_short_name(n) for n in (*GLOBAL_PLANNERS, *LOCAL_PLANNERS)} - {gname, lname}
@@ -185,6 +196,7 @@ class MoveBase(Node):
         self.cmd_pub = self.create_publisher(Twist, "cmd_vel", 1)
         self.goal_pub = self.create_publisher(PoseStamped, "~/current_goal", 1)
         self.plan_pub = self.create_publisher(Path, f"~/{gname}/plan", 1)
+        self.potential_pub = PotentialPublisher(self, gname, self.planner)
         self.local_global_plan_pub = self.create_publisher(Path, f"~/{lname}/global_plan", 1)
         self.local_plan_pub = self.create_publisher(Path, f"~/{lname}/local_plan", 1)
         self.server = SimpleActionServer(self, "move_base", "move_base_msgs/MoveBaseAction")
@@ -196,7 +208,9 @@ class MoveBase(Node):
         self._simple_goals = 0
         self.create_subscription(PoseStamped, "move_base_simple/goal", self._on_simple_goal, 1)
         self._twist = Velocity2D()
-        self.create_subscription(mc.Odometry, "odom", self._on_odom, 1)
+        # the local planner's odom_topic (base_local_planner's OdometryHelperRos)
+        odom_topic = str(lvalues.get("odom_topic", "odom"))
+        self.create_subscription(mc.Odometry, odom_topic, self._on_odom, 1)
         self.create_service("nav_msgs/GetPlan", "~/make_plan", self._on_make_plan)
         self.create_service("std_srvs/Empty", "~/clear_costmaps", self._on_clear_costmaps)
         self.create_timer(1.0 / p.controller_frequency, self._cycle)
@@ -206,7 +220,9 @@ class MoveBase(Node):
         self.state = PLANNING
         self.recovery_trigger = PLANNING_R
         self.recovery_index = 0
-        self._recovery_running: RotateRecovery | None = None
+        self.recovering = Recovering(
+            self, rotate_fallback(limits, self.local_costmap.footprint, body)
+        )
         self._last_valid_plan = 0.0
         self._last_valid_control = 0.0
         self._last_oscillation_reset = 0.0
@@ -298,7 +314,7 @@ class MoveBase(Node):
         self.state = PLANNING
         self.recovery_index = 0
         self.recovery_trigger = PLANNING_R
-        self._recovery_running = None
+        self.recovering.running = None
         self._last_valid_plan = self._last_valid_control = now
         self._last_oscillation_reset = now
         self._oscillation_pose = None
@@ -317,7 +333,7 @@ class MoveBase(Node):
         self.state = PLANNING
         self.recovery_index = 0
         self.recovery_trigger = PLANNING_R
-        self._recovery_running = None
+        self.recovering.running = None
         self.goal = None
         self.plan = None
         self.publish_zero_velocity()
@@ -374,7 +390,7 @@ class MoveBase(Node):
         elif self.state == CONTROLLING:
             self._control_step(now)
         else:
-            self._clear_step(now)
+            self.recovering.clear_step(now)
 
     def _plan_step(self, now: float, gpose: SE2 | None) -> None:
         assert self.goal is not None
@@ -458,6 +474,7 @@ class MoveBase(Node):
         if self.recovery_trigger == PLANNING_R:
             self.recovery_index = 0
         self._publish_path(self.plan_pub, self.plan, self.global_frame)
+        self.potential_pub.publish(gpose, self.global_frame, self.global_costmap.costmap.resolution)
         try:
             self.controller.set_plan(self._plan_in_local_frame())
         except (TransformException, NavigationError) as err:
@@ -510,6 +527,7 @@ class MoveBase(Node):
         self._last_valid_control = now
         if self.recovery_trigger == CONTROLLING_R:
             self.recovery_index = 0
+        cmd = self.recovering.limited(cmd, lpose)
         self.cmd_pub.publish(Twist(linear_x=cmd.vx, linear_y=cmd.vy, angular_z=cmd.wz))
         trajectory = getattr(self.controller, "trajectory", None)
         if trajectory is not None and len(trajectory):
@@ -518,59 +536,9 @@ class MoveBase(Node):
             )
         self._publish_path(self.local_global_plan_pub, local_plan, self.local_costmap.global_frame)
 
-    def _clear_step(self, now: float) -> None:
-        running = self._recovery_running
-        if running is not None:
-            lpose = self.local_costmap.get_robot_pose()
-            speed = None if lpose is None else running.step(lpose, self.local_costmap.costmap)
-            if speed is not None:
-                self.cmd_pub.publish(Twist(angular_z=speed))
-                return
-            if running.blocked:
-                self.get_logger().error(running.blocked)
-            self.publish_zero_velocity()
-            self._recovery_done(now)
-            return
-        p = self.params
-        if not (p.recovery_behavior_enabled and self.recovery_index < len(self.recoveries)):
-            self.get_logger().error(
-                "All recovery behaviors have failed, locking the planner and disabling it."
-            )
-            self._abort(ABORT_TEXTS[self.recovery_trigger])
-            return
-        rec = self.recoveries[self.recovery_index]
-        self.get_logger().info(f"Executing recovery behavior {rec.name}")
-        if isinstance(rec, ClearCostmapRecovery):
-            cleared = rec.run(
-                global_costmap=self.global_costmap.layered,
-                global_pose=self.global_costmap.get_robot_pose(),
-                local_costmap=self.local_costmap.layered,
-                local_pose=self.local_costmap.get_robot_pose(),
-            )
-            self.get_logger().info(
-                f"{rec.name}: cleared {', '.join(cleared) or 'nothing'} outside a "
-                f"{rec.reset_distance:.2f} m square around the robot"
-            )
-            if rec.force_updating:
-                self.global_costmap.update_map()
-                self.local_costmap.update_map()
-            self._recovery_done(now)
-            return
-        lpose = self.local_costmap.get_robot_pose()
-        if lpose is None:
-            self._recovery_done(now)
-            return
-        rec.start(lpose)
-        self._recovery_running = rec
-        self._clear_step(now)
-
-    def _recovery_done(self, now: float) -> None:
-        self._recovery_running = None
-        self._last_oscillation_reset = now
-        self._last_valid_plan = now
-        self._planning_retries = 0
-        self.state = PLANNING
-        self.recovery_index += 1
+    def abort_text(self) -> str:
+        """move_base's text for an ABORT after the recoveries."""
+        return ABORT_TEXTS[self.recovery_trigger]
 
     # ------------------------------------------------------------------ services
     def _on_make_plan(self, request: Any, response: Any) -> Any:
@@ -587,6 +555,8 @@ class MoveBase(Node):
             raise NavigationError(f"make_plan: {err}") from err
         if start is None:
             raise NavigationError("make_plan: the robot's pose is not known")
+        if self.params.make_plan_clear_costmap:
+            self.recovering.clear_around_robot(self._clearing_radius())
         planner: Any = self.planner
         tol = float(request.tolerance)
         if tol > 0 and hasattr(planner, "params"):  # the request's tolerance, for this plan
@@ -597,8 +567,18 @@ class MoveBase(Node):
             self.get_logger().warning(f"make_plan: {err}")
             response.plan = Path(header_frame_id=self.global_frame)
             return response
+        if self.params.make_plan_add_unreachable_goal and len(path):
+            end = np.asarray(path)[-1]
+            if math.hypot(end[0] - goal.x, end[1] - goal.y) > 1e-6:
+                # the goal itself, in case the local planner can get the robot there
+                path = np.vstack([path, goal.as_array()])
         response.plan = path_to_msg(path, self.global_frame, self.get_clock().now())
         return response
+
+    def _clearing_radius(self) -> float:
+        """move_base's ``clearing_radius`` (default: the circumscribed radius)."""
+        r = self.params.clearing_radius
+        return footprint_radii(self.global_costmap.footprint)[1] if r is None else r
 
     def _on_clear_costmaps(self, _request: Any, response: Any) -> Any:
         """``~clear_costmaps``: reset both costmaps' layers."""

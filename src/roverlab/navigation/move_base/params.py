@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-import difflib
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
 from typing import Any
 
 from roverlab.navigation.errors import NavigationParamsError
+from roverlab.navigation.params import unknown_warning
 
 __all__ = [
     "GLOBAL_PLANNERS",
@@ -28,12 +28,17 @@ LOCAL_PLANNERS = (
     "base_local_planner/TrajectoryPlannerROS",
 )
 #: ``recovery_behaviors`` types roverlab implements.
-RECOVERY_TYPES = ("clear_costmap_recovery/ClearCostmapRecovery", "rotate_recovery/RotateRecovery")
-
-# parameters of move_base that roverlab reads elsewhere or has no use for (accepted quietly)
-IGNORED = frozenset(
-    {"restore_defaults", "make_plan_clear_costmap", "make_plan_add_unreachable_goal"}
+RECOVERY_TYPES = (
+    "clear_costmap_recovery/ClearCostmapRecovery",
+    "rotate_recovery/RotateRecovery",
+    "move_slow_and_clear/MoveSlowAndClear",
+    "nav2_behaviors/BackUp",
+    "nav2_behaviors/Spin",
+    "nav2_behaviors/Wait",
 )
+
+# dynamic_reconfigure's reset switch: nothing to reset in a parameter set read once
+IGNORED = frozenset({"restore_defaults"})
 
 
 @dataclass(frozen=True)
@@ -83,6 +88,12 @@ class MoveBaseParams:
             goal comes or the local planner fails).
         max_planning_retries: planning failures before recovery (-1: until
             ``planner_patience``).
+        make_plan_clear_costmap: ``~make_plan`` first clears the obstacle layers in a
+            ``2 * clearing_radius`` square around the robot.
+        make_plan_add_unreachable_goal: a ``~make_plan`` answer that stops short of the
+            goal (within the request's tolerance) ends with the goal itself.
+        clearing_radius: that square's half side (m; None: the footprint's circumscribed
+            radius, as move_base).
         plan_footprint_check: roverlab's addition (not in ROS): re-plan around places
             where the footprint, heading along the plan, would touch a lethal cell
             (:mod:`roverlab.navigation.planners.footprint_check`); false plans as ROS does.
@@ -102,6 +113,9 @@ class MoveBaseParams:
     oscillation_distance: float = 0.5
     planner_frequency: float = 0.0
     max_planning_retries: int = -1
+    make_plan_clear_costmap: bool = True
+    make_plan_add_unreachable_goal: bool = True
+    clearing_radius: float | None = None
     plan_footprint_check: bool = True
 
     def __post_init__(self) -> None:
@@ -128,9 +142,10 @@ class MoveBaseParams:
             "oscillation_timeout",
             "oscillation_distance",
             "planner_frequency",
+            "clearing_radius",
         ):
             v = getattr(self, name)
-            if not (math.isfinite(v) and v >= 0):
+            if v is not None and not (math.isfinite(v) and v >= 0):
                 raise NavigationParamsError(f"{w}: {name} must be >= 0, got {v}")
         for r in self.recovery_behaviors:
             if r.type not in RECOVERY_TYPES:
@@ -145,25 +160,28 @@ class MoveBaseParams:
         return self.recovery_behaviors or default_recoveries(self.clearing_rotation_allowed)
 
     @classmethod
-    def from_ros(cls, values: Mapping[str, Any]) -> MoveBaseParams:
+    def from_ros(cls, values: Mapping[str, Any]) -> tuple[MoveBaseParams, tuple[str, ...]]:
         """From move_base's private parameters; plugin parameters (``NAME/...``, the
         costmaps', planners' and recoveries') are left to their plugins.
 
+        Returns:
+            The parameters and warnings (an unknown name: ROS ignores it, we name it).
+
         Raises:
-            NavigationParamsError: a bad value or an unknown name, named.
+            NavigationParamsError: a bad value, named.
         """
         names = {f.name: f for f in fields(cls)}
         kwargs: dict[str, Any] = {}
+        warnings: list[str] = []
         recoveries = _recoveries(values.get("recovery_behaviors"))
         for key, value in values.items():
             if key == "recovery_behaviors" or key in IGNORED or "/" in key or "." in key:
                 continue
             if key not in names:
-                close = difflib.get_close_matches(key, list(names), n=1)
-                hint = f" (did you mean {close[0]!r}?)" if close else ""
-                raise NavigationParamsError(f"move_base: unknown parameter {key!r}{hint}")
+                warnings.append(unknown_warning("move_base", key, names))
+                continue
             kwargs[key] = _convert(key, value, names[key].default)
-        return cls(recovery_behaviors=recoveries, **kwargs)
+        return cls(recovery_behaviors=recoveries, **kwargs), tuple(warnings)
 
 
 def _convert(key: str, value: Any, default: Any) -> Any:
@@ -180,7 +198,7 @@ def _convert(key: str, value: Any, default: Any) -> Any:
         if isinstance(value, float) and value.is_integer():
             return int(value)
         raise NavigationParamsError(f"{where} must be an integer, got {value!r}")
-    if isinstance(default, float):
+    if isinstance(default, float) or (default is None and key == "clearing_radius"):
         if isinstance(value, int | float) and not isinstance(value, bool):
             return float(value)
         try:

@@ -11,6 +11,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
 from numpy.typing import ArrayLike
 
 from roverlab.navigation.controllers import (
@@ -20,12 +21,21 @@ from roverlab.navigation.controllers import (
     TebParams,
     TebPlanner,
 )
+from roverlab.navigation.costmap.footprint import footprint_radii
 from roverlab.navigation.errors import NavigationParamsError
+from roverlab.navigation.move_base.behaviors import (
+    BackUp,
+    BehaviorParams,
+    MoveSlowAndClear,
+    Spin,
+    Wait,
+)
 from roverlab.navigation.move_base.recovery import (
     ClearCostmapRecovery,
     RotateRecovery,
     RotateRecoveryParams,
 )
+from roverlab.navigation.params import unknown_warning
 from roverlab.navigation.planners import (
     GlobalPlanner,
     GlobalPlannerParams,
@@ -40,6 +50,7 @@ __all__ = [
     "make_local_planner",
     "make_recovery",
     "plugin_short_name",
+    "rotate_fallback",
 ]
 
 
@@ -72,10 +83,17 @@ class LocalPlannerLimits:
 
 
 def make_local_planner(
-    plugin: str, values: Mapping[str, Any], *, footprint: ArrayLike, controller_frequency: float
+    plugin: str,
+    values: Mapping[str, Any],
+    *,
+    footprint: ArrayLike,
+    controller_frequency: float,
+    body_footprint: ArrayLike | None = None,
 ) -> tuple[ControllerProtocol, LocalPlannerLimits, tuple[str, ...]]:
     """The local planner ``plugin`` with its parameters (``controller_frequency`` is
-    move_base's, as ROS's local planners search it up), its rotation limits, warnings."""
+    move_base's, as ROS's local planners search it up), its rotation limits, warnings.
+    ``footprint`` is the costmap's (padded) one, ``body_footprint`` the robot's own (the
+    escape checks it; None: ``footprint``)."""
     if plugin in ("dwa_local_planner/DWAPlannerROS", "base_local_planner/TrajectoryPlannerROS"):
         merged = {"controller_frequency": controller_frequency, **values}
         if plugin == "dwa_local_planner/DWAPlannerROS":
@@ -88,7 +106,7 @@ def make_local_planner(
             min_in_place_rotational_vel=dp.min_vel_theta,
             yaw_goal_tolerance=dp.yaw_goal_tolerance,
         )
-        return DWAPlanner(dp, footprint=footprint), limits, warnings
+        return DWAPlanner(dp, footprint=footprint, body_footprint=body_footprint), limits, warnings
     if plugin == "teb_local_planner/TebLocalPlannerROS":
         tp, warnings = TebParams.from_ros(values)
         limits = LocalPlannerLimits(
@@ -101,7 +119,23 @@ def make_local_planner(
     raise NavigationParamsError(f"move_base: unknown base_local_planner {plugin!r}")
 
 
-Recovery = ClearCostmapRecovery | RotateRecovery
+Recovery = ClearCostmapRecovery | RotateRecovery | MoveSlowAndClear | BackUp | Spin | Wait
+_BEHAVIORS: dict[str, type[BackUp | Spin | Wait]] = {
+    "nav2_behaviors/BackUp": BackUp,
+    "nav2_behaviors/Spin": Spin,
+    "nav2_behaviors/Wait": Wait,
+}
+
+
+def rotate_fallback(limits: LocalPlannerLimits, footprint: ArrayLike, body: ArrayLike) -> BackUp:
+    """What a rotate_recovery that cannot turn hands over to: backing up at 0.1 m/s far
+    enough for the padded footprint to clear what the body clears (its circumscribed
+    radius less the body's inscribed radius, at least 0.1 m), the body checked."""
+    _, circumscribed = footprint_radii(np.asarray(footprint, dtype=np.float64).reshape(-1, 2))
+    inscribed, _ = footprint_radii(np.asarray(body, dtype=np.float64).reshape(-1, 2))
+    params = BehaviorParams(backup_dist=max(0.1, circumscribed - inscribed), backup_speed=0.1,
+                            max_rotational_vel=limits.max_rotational_vel)  # fmt: skip
+    return BackUp("rotate_recovery/back_up", params, footprint=body)
 
 
 def make_recovery(
@@ -113,8 +147,9 @@ def make_recovery(
     limits: LocalPlannerLimits,
     trajectory_planner: Mapping[str, Any],
     footprint: ArrayLike,
-) -> Recovery:
-    """One recovery behaviour.
+    body_footprint: ArrayLike | None = None,
+) -> tuple[Recovery, tuple[str, ...]]:
+    """One recovery behaviour, and warnings (unknown names: ROS ignores them).
 
     ``clear_costmap_recovery/ClearCostmapRecovery``: ``reset_distance`` defaults to
     ``default_reset_distance`` (move_base: ``conservative_reset_dist``, or four times the
@@ -123,14 +158,22 @@ def make_recovery(
     rotation limits from ``~TrajectoryPlannerROS/`` as ROS 1 reads them, else from the
     local planner in use (ROS falls back to fixed defaults there).
     """
+    warnings: list[str] = []
+    body = footprint if body_footprint is None else body_footprint
+    behavior = _BEHAVIORS.get(plugin)
+    if behavior is not None:
+        bp, bw = BehaviorParams.from_ros(name, values)
+        return behavior(name, bp, footprint=body), bw
+    if plugin == "move_slow_and_clear/MoveSlowAndClear":
+        return MoveSlowAndClear.from_ros(name, values)
     if plugin == "clear_costmap_recovery/ClearCostmapRecovery":
-        return ClearCostmapRecovery.from_ros(
-            name, values, default_reset_distance=default_reset_distance
+        rec = ClearCostmapRecovery.from_ros(
+            name, values, default_reset_distance=default_reset_distance, warnings=warnings
         )
+        return rec, tuple(warnings)
     if plugin == "rotate_recovery/RotateRecovery":
-        unknown = sorted(set(values) - {"sim_granularity", "frequency"})
-        if unknown:
-            raise NavigationParamsError(f"{name}: unknown parameter(s) {', '.join(unknown)}")
+        known = ("sim_granularity", "frequency")
+        warnings += [unknown_warning(name, k, known) for k in sorted(set(values) - set(known))]
         tp = trajectory_planner
         get: Callable[[str, float], float] = lambda key, fallback: float(  # noqa: E731
             tp.get(key, fallback)
@@ -148,5 +191,5 @@ def make_recovery(
             )
         except (TypeError, ValueError) as err:
             raise NavigationParamsError(f"{name}: {err}") from None
-        return RotateRecovery(name, params, footprint=footprint)
+        return RotateRecovery(name, params, footprint=footprint), tuple(warnings)
     raise NavigationParamsError(f"move_base: unknown recovery behavior type {plugin!r}")

@@ -22,6 +22,7 @@ from roverlab.navigation.costmap.kernels import footprint_cost
 from roverlab.navigation.costmap.layered import CostmapLayer, LayeredCostmap
 from roverlab.navigation.costmap.obstacle_layer import ObstacleLayer
 from roverlab.navigation.errors import NavigationParamsError
+from roverlab.navigation.params import unknown_warning
 
 __all__ = ["ClearCostmapRecovery", "RotateRecovery", "RotateRecoveryParams"]
 
@@ -72,12 +73,18 @@ class ClearCostmapRecovery:
 
     @classmethod
     def from_ros(
-        cls, name: str, values: Mapping[str, Any], *, default_reset_distance: float
+        cls,
+        name: str,
+        values: Mapping[str, Any],
+        *,
+        default_reset_distance: float,
+        warnings: list[str] | None = None,
     ) -> ClearCostmapRecovery:
-        """From the recovery's ROS parameters (``~NAME/reset_distance``, ...).
+        """From the recovery's ROS parameters (``~NAME/reset_distance``, ...); an unknown
+        name is appended to ``warnings`` (ROS ignores it).
 
         Raises:
-            NavigationParamsError: a bad or unknown parameter, named.
+            NavigationParamsError: a bad parameter, named.
         """
         known = {
             "reset_distance",
@@ -86,9 +93,9 @@ class ClearCostmapRecovery:
             "invert_area_to_clear",
             "force_updating",
         }
-        unknown = sorted(set(values) - known)
-        if unknown:
-            raise NavigationParamsError(f"{name}: unknown parameter(s) {', '.join(unknown)}")
+        for key in sorted(set(values) - known):
+            if warnings is not None:
+                warnings.append(unknown_warning(name, key, known))
         layers = values.get("layer_names")
         if layers is not None and (
             not isinstance(layers, list | tuple) or not all(isinstance(x, str) for x in layers)

@@ -84,8 +84,16 @@ class GlobalPlannerParams:
         Raises:
             NavigationParamsError: an unknown name or a bad value.
         """
-        p, res = build_params(cls, values, where="global_planner")
-        return p, res.warnings
+        # GlobalPlanner reads planner_window_x/y and never uses them
+        ignored = ("planner_window_x", "planner_window_y")
+        p, res = build_params(cls, values, where="global_planner", ignored=ignored)
+        warnings = list(res.warnings)
+        if p.visualize_potential:
+            warnings.append(
+                "global_planner: visualize_potential has no effect: the potential is the "
+                "~GlobalPlanner/potential grid (publish_potential)"
+            )
+        return p, tuple(warnings)
 
 
 class GlobalPlanner:

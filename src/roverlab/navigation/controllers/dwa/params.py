@@ -8,14 +8,15 @@ Renamed names are accepted with a warning when the new one is not set, as DWAPla
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
 from roverlab.navigation.errors import NavigationParamsError
-from roverlab.navigation.params import build_params, check
+from roverlab.navigation.params import build_params, check, unknown_warning
 
-__all__ = ["DWAParams"]
+__all__ = ["NODE_KEYS", "DWAParams"]
 
 _RENAMED = {
     "max_trans_vel": "max_vel_trans",
@@ -25,7 +26,16 @@ _RENAMED = {
     "acc_limit_trans": "acc_lim_trans",
     "rot_stopped_vel": "theta_stopped_vel",
 }
-_IGNORED = ("publish_traj_pc", "publish_cost_grid_pc", "global_frame_id", "restore_defaults")
+# visualisation only (point clouds roverlab does not publish), or dynamic_reconfigure's
+# reset switch; DWAPlanner's cheat_factor scales only the cost-grid cloud
+_IGNORED = (
+    "publish_traj_pc",
+    "publish_cost_grid_pc",
+    "global_frame_id",
+    "cheat_factor",
+)
+#: names the node reads, not the planner (``odom_topic``: move_base's odometry subscription)
+NODE_KEYS = frozenset({"odom_topic", "restore_defaults"})
 
 # TrajectoryPlannerROS (base_local_planner) defaults, for the names that map
 _TP_DEFAULTS: dict[str, Any] = {
@@ -53,19 +63,34 @@ _TP_DEFAULTS: dict[str, Any] = {
     "oscillation_reset_dist": 0.05,
     "prune_plan": True,
     "dwa": True,
+    "escape_vel": -0.1,
+    "escape_reset_dist": 0.10,
+    "escape_reset_theta": math.pi / 4,
+    "heading_scoring": False,
+    "simple_attractor": False,
+    "world_model": "costmap",
 }
+# read by TrajectoryPlanner only with heading_scoring (warned when true), or visualisation;
+# min_vel_theta is not one of TrajectoryPlannerROS's parameters (min_in_place_vel_theta is)
 _TP_IGNORED = (
-    "escape_vel",
-    "escape_reset_dist",
-    "escape_reset_theta",
     "heading_lookahead",
-    "heading_scoring",
     "heading_scoring_timestep",
-    "simple_attractor",
     "publish_cost_grid_pc",
     "global_frame_id",
     "min_vel_theta",
 )
+# TrajectoryPlannerROS's deprecated names (it warns and reads them)
+_TP_RENAMED = {
+    "backup_vel": "escape_vel",
+    "min_in_place_rotational_vel": "min_in_place_vel_theta",
+    "max_rotational_vel": "max_vel_theta",
+}
+# other spellings read as these (rotate_recovery's acc_lim_th; DWA's bias names)
+_TP_ALIAS = {
+    "acc_lim_th": "acc_lim_theta",
+    "path_distance_bias": "pdist_scale",
+    "goal_distance_bias": "gdist_scale",
+}
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -76,6 +101,12 @@ class DWAParams:
     move_base; ``sim_period = 1 / controller_frequency``), ``holonomic_robot`` (False forces
     ``vy = 0``; None: the ``min/max_vel_y`` decide, as DWA) and ``meter_scoring`` (False:
     the biases weigh cells, not metres: TrajectoryPlannerROS's default).
+
+    base_local_planner's escape (TrajectoryPlannerROS's names and defaults, used by
+    DWAPlannerROS too, where ROS has none): when every sampled trajectory is rejected the
+    robot backs up at ``escape_vel`` (m/s, < 0; 0 turns escaping off) while its real
+    footprint stays clear, and forward motion is not sampled until it has moved
+    ``escape_reset_dist`` (m) or turned ``escape_reset_theta`` (rad) from where it began.
     """
 
     max_vel_trans: float = 0.55
@@ -117,9 +148,17 @@ class DWAParams:
     controller_frequency: float = 20.0
     holonomic_robot: bool | None = None
     meter_scoring: bool = True
+    escape_vel: float = -0.1
+    escape_reset_dist: float = 0.10
+    escape_reset_theta: float = math.pi / 4
 
     def __post_init__(self) -> None:
         w = "dwa_local_planner"
+        check(
+            self.escape_vel <= 0, f"{w}: escape_vel must be <= 0 (backwards), got {self.escape_vel}"
+        )
+        check(self.escape_reset_dist >= 0, f"{w}: escape_reset_dist must be >= 0")
+        check(self.escape_reset_theta >= 0, f"{w}: escape_reset_theta must be >= 0")
         for name in (
             "max_vel_trans",
             "max_vel_theta",
@@ -174,12 +213,18 @@ class DWAParams:
         """From ``DWAPlannerROS/...`` parameters (ROS names; old names renamed).
 
         Raises:
-            NavigationParamsError: an unknown name or a bad value.
+            NavigationParamsError: a bad value (an unknown name is a warning).
         """
+        values = {k: v for k, v in values.items() if k not in NODE_KEYS}
         p, res = build_params(
             cls, values, where="dwa_local_planner", renamed=_RENAMED, ignored=_IGNORED
         )
         warnings = list(res.warnings)
+        if "acc_lim_trans" in values or "acc_limit_trans" in values:
+            warnings.append(
+                "dwa_local_planner: parameter acc_lim_trans has no effect: the trajectory "
+                "generator limits acc_lim_x and acc_lim_y, as ROS's does"
+            )
         for name in ("vx_samples", "vy_samples", "vth_samples"):
             if getattr(p, name) <= 0:
                 warnings.append(
@@ -200,26 +245,41 @@ class DWAParams:
         shift those two critics repeat the path and goal ones.
 
         Raises:
-            NavigationParamsError: an unknown name or a bad value.
+            NavigationParamsError: a bad value (an unknown name is a warning).
         """
         v = dict(_TP_DEFAULTS)
-        alias = {
-            "acc_lim_th": "acc_lim_theta",
-            "max_rotational_vel": "max_vel_theta",
-            "path_distance_bias": "pdist_scale",
-            "goal_distance_bias": "gdist_scale",
-        }
+        w = "base_local_planner"
         warnings: list[str] = []
         for key, value in values.items():
-            if key in _TP_IGNORED:
-                warnings.append(
-                    f"base_local_planner: parameter {key} is not implemented by roverlab (ignored)"
-                )
+            if key in NODE_KEYS:
                 continue
-            key = alias.get(key, key)
-            if key not in _TP_DEFAULTS and key not in ("angular_sim_granularity",):
-                raise NavigationParamsError(f"base_local_planner: unknown parameter {key!r}")
+            if key in _TP_IGNORED:
+                warnings.append(f"{w}: parameter {key} has no effect in roverlab (ignored)")
+                continue
+            new = _TP_RENAMED.get(key)
+            if new is not None:
+                if new in values:
+                    warnings.append(f"{w}: parameter {key} is deprecated and {new} is set")
+                    continue
+                warnings.append(f"{w}: parameter {key} has been renamed to {new}")
+                key = new
+            key = _TP_ALIAS.get(key, key)
+            if key not in _TP_DEFAULTS and key != "angular_sim_granularity":
+                known = [*_TP_DEFAULTS, *_TP_RENAMED, *_TP_ALIAS]
+                warnings.append(unknown_warning(w, key, known))
+                continue
             v[key] = value
+        for key, why in (
+            ("heading_scoring", "the path distance is scored, not the heading to the path"),
+            ("simple_attractor", "the path and goal distances are scored"),
+        ):
+            if v[key] is True:
+                warnings.append(f"{w}: {key} true is not implemented by roverlab ({why})")
+        if v["world_model"] != "costmap":
+            warnings.append(
+                f"{w}: world_model {v['world_model']!r} is not implemented: the costmap's "
+                "cells are checked (world_model costmap)"
+            )
         y_vels = v["y_vels"]
         if not isinstance(y_vels, list | tuple) or not y_vels:
             raise NavigationParamsError("base_local_planner: y_vels must be a list of speeds")
@@ -258,6 +318,9 @@ class DWAParams:
             "forward_point_distance": 0.0,
             "scaling_speed": 0.0,
             "max_scaling_factor": 0.0,
+            "escape_vel": v["escape_vel"],
+            "escape_reset_dist": v["escape_reset_dist"],
+            "escape_reset_theta": v["escape_reset_theta"],
         }
         for name, key in (
             ("path_distance_bias", "pdist_scale"),

@@ -15,6 +15,17 @@ Per control cycle, as DWAPlannerROS::computeVelocityCommands:
   ``sim_time`` and scored by the critics of :mod:`.kernels` in one compiled call; the
   cheapest valid sample is the command, and the oscillation flags are updated.
 
+When every sample is refused, base_local_planner's escape (TrajectoryPlanner's
+``escape_vel``, ``escape_reset_dist``, ``escape_reset_theta``, here for DWAPlannerROS too):
+the robot backs up at ``escape_vel`` and forward samples are left out until it has moved
+``escape_reset_dist`` or turned ``escape_reset_theta`` from where the escape began. ROS
+backs up blind ("even when the static map shows it as blocked"); roverlab backs up only
+while the robot's real (unpadded) footprint stays clear of lethal cells, which is what
+frees a robot whose *padded* footprint touches an obstacle its body clears. Before that,
+when the padded footprint is refused where the robot stands but its body is clear, the
+samples are scored with the body's footprint and the cheapest whose last pose is clear
+with the padded one is taken; once backing up is blocked too, forward samples return.
+
 Failures raise :class:`NoValidControlError` (the robot must stop) or
 :class:`InvalidPathError`.
 """
@@ -127,10 +138,20 @@ class DWAPlanner:
 
     name = "dwa_local_planner/DWAPlannerROS"
 
-    def __init__(self, params: DWAParams | None = None, *, footprint: ArrayLike = ()) -> None:
+    def __init__(
+        self,
+        params: DWAParams | None = None,
+        *,
+        footprint: ArrayLike = (),
+        body_footprint: ArrayLike | None = None,
+    ) -> None:
         self.params = params or DWAParams()
         fp = np.asarray(footprint, dtype=np.float64).reshape(-1, 2)
         self.footprint = np.ascontiguousarray(fp)
+        body = fp if body_footprint is None else np.asarray(body_footprint, dtype=np.float64)
+        self.body_footprint = np.ascontiguousarray(body.reshape(-1, 2))
+        self.escaping = False
+        self._escape_from = SE2()
         self._orig_plan: NDArray[np.float64] | None = None
         self._plan: NDArray[np.float64] = np.zeros((0, 3))
         self.local_plan: NDArray[np.float64] = np.zeros((0, 3))
@@ -245,7 +266,7 @@ class DWAPlanner:
     # ------------------------------------------------------------------ scoring
     def _score(
         self, pose: SE2, vel: Velocity2D, samples: NDArray[np.float64], cm: Costmap2D,
-        flags: NDArray[np.bool_], prune: bool = True,
+        flags: NDArray[np.bool_], prune: bool = True, footprint: NDArray[np.float64] | None = None,
     ) -> tuple[int, NDArray[np.float64]]:  # fmt: skip
         p = self.params
         out = np.empty(len(samples))
@@ -258,7 +279,8 @@ class DWAPlanner:
             np.ascontiguousarray(samples), pose.as_array(), vel.as_array(), gen,
             np.array([p.acc_lim_x, p.acc_lim_y, p.acc_lim_theta]), not p.use_dwa,
             cm.costs, cm.resolution, cm.origin_x, cm.origin_y, self._grids[0], self._grids[1],
-            self._grids[2], self.footprint, self._scales, scaling, p.sum_scores, flags, prune,
+            self._grids[2], self.footprint if footprint is None else footprint, self._scales,
+            scaling, p.sum_scores, flags, prune,
             out,
         )  # fmt: skip
         return int(best), out
@@ -367,10 +389,19 @@ class DWAPlanner:
         self.trajectory = np.zeros((0, 3))
         if self._position_reached(pose):
             return self._stop_rotate(pose, twist, costmap)
-        samples = self._sample_velocities(pose, twist)
-        best, costs = self._score(pose, twist, samples, costmap, self._only)
+        self._update_escape(pose)
+        every = self._sample_velocities(pose, twist)
+        # TrajectoryPlanner samples no forward motion while escaping
+        samples = every[every[:, 0] <= 0.0] if self.escaping else every
+        best, costs = self._best(pose, twist, samples, costmap)
         if best < 0:
-            best, costs = self._escape(pose, twist, samples, costmap, costs)
+            back = self._back_up(pose, twist, costmap)
+            if back is not None:
+                return back
+            if self.escaping:  # no room to back up any further: forward motion again
+                self.escaping = False
+                samples = every
+                best, costs = self._best(pose, twist, samples, costmap)
         self.samples, self.costs = samples, costs
         if best < 0:
             raise NoValidControlError(
@@ -439,6 +470,94 @@ class DWAPlanner:
                 continue
             return int(k), rcosts
         return -1, costs
+
+    def _best(
+        self, pose: SE2, vel: Velocity2D, samples: NDArray[np.float64], cm: Costmap2D
+    ) -> tuple[int, NDArray[np.float64]]:
+        """The cheapest valid sample, else the ways out of a lethal cell under the outline
+        and of an obstacle inside the padding; ``(-1, costs)`` when none."""
+        best, costs = self._score(pose, vel, samples, cm, self._only)
+        if best < 0:
+            best, costs = self._escape(pose, vel, samples, cm, costs)
+        if best < 0:
+            best, costs = self._body_escape(pose, vel, samples, cm, costs)
+        return best, costs
+
+    def _body_escape(
+        self, pose: SE2, vel: Velocity2D, samples: NDArray[np.float64], cm: Costmap2D,
+        costs: NDArray[np.float64],
+    ) -> tuple[int, NDArray[np.float64]]:  # fmt: skip
+        """When the padded footprint is refused where the robot stands but its body is
+        clear (an obstacle inside the padding): the samples scored with the body's
+        footprint, the cheapest one taken whose last pose is clear with the padded one."""
+        body, fp = self.body_footprint, self.footprint
+        if len(body) < 3 or (body.shape == fp.shape and np.array_equal(body, fp)):
+            return -1, costs
+        p = self.params
+        args = (cm.resolution, cm.origin_x, cm.origin_y)
+        line = np.empty((cm.size_x + cm.size_y + 4, 2), dtype=np.int64)
+        if footprint_cost(cm.costs, *args, pose.x, pose.y, pose.theta, body, 1.0, line) < 0:
+            return -1, costs
+        best, bcosts = self._score(pose, vel, samples, cm, self._only, prune=False, footprint=body)
+        if best < 0:
+            return -1, costs
+        acc = np.array([p.acc_lim_x, p.acc_lim_y, p.acc_lim_theta])
+        traj = np.empty((int(p.sim_time / min(p.sim_granularity, 1.0)) * 4 + 64, 3))
+        for k in np.argsort(np.where(bcosts >= 0, bcosts, np.inf), kind="stable"):
+            if bcosts[k] < 0:
+                break
+            num, _, _ = rollout(
+                pose.as_array(), vel.as_array(), samples[k], p.sim_time, p.sim_granularity,
+                p.angular_sim_granularity, not p.use_dwa, acc, 0.0, traj,
+            )  # fmt: skip
+            x, y, th = (float(v) for v in traj[max(num - 1, 0)])
+            if num and footprint_cost(cm.costs, *args, x, y, th, fp, 1.0, line) >= 0:
+                return int(k), bcosts
+        return -1, costs
+
+    def _update_escape(self, pose: SE2) -> None:
+        """The escape ends once the robot is ``escape_reset_dist`` away from, or
+        ``escape_reset_theta`` turned from, where it began."""
+        if not self.escaping:
+            return
+        p, start = self.params, self._escape_from
+        if (
+            math.hypot(pose.x - start.x, pose.y - start.y) > p.escape_reset_dist
+            or abs(angle_diff(pose.theta, start.theta)) > p.escape_reset_theta
+        ):
+            self.escaping = False
+
+    def _back_up(self, pose: SE2, twist: Velocity2D, cm: Costmap2D) -> Velocity2D | None:
+        """TrajectoryPlanner's last resort: straight back at ``escape_vel`` (acceleration
+        limited), if the real footprint stays clear of lethal and unknown cells for
+        ``escape_reset_dist`` (or the whole ``sim_time`` if that is shorter); None
+        otherwise (or with ``escape_vel`` 0)."""
+        p = self.params
+        if p.escape_vel >= 0.0:
+            return None
+        cmd = np.array([p.escape_vel, 0.0, 0.0])
+        acc = np.array([p.acc_lim_x, p.acc_lim_y, p.acc_lim_theta])
+        traj = np.empty((int(p.sim_time / min(p.sim_granularity, 1.0)) * 4 + 64, 3))
+        num, _, _ = rollout(
+            pose.as_array(), twist.as_array(), cmd, p.sim_time, p.sim_granularity,
+            p.angular_sim_granularity, True, acc, 0.0, traj,
+        )  # fmt: skip
+        need = min(p.escape_reset_dist, abs(p.escape_vel) * p.sim_time)
+        line = np.empty((cm.size_x + cm.size_y + 4, 2), dtype=np.int64)
+        for x, y, th in traj[:num]:
+            if footprint_cost(
+                cm.costs, cm.resolution, cm.origin_x, cm.origin_y, float(x), float(y),
+                float(th), self.body_footprint, 1.0, line,
+            ) < 0:  # fmt: skip
+                return None
+            if math.hypot(x - pose.x, y - pose.y) >= need:
+                break
+        if not self.escaping:
+            self.escaping = True
+            self._escape_from = pose
+        self.trajectory = traj[:num].copy()
+        vx = max(p.escape_vel, twist.vx - p.acc_lim_x * p.sim_period)
+        return Velocity2D(vx, 0.0, 0.0)
 
     def _stop_rotate(self, pose: SE2, twist: Velocity2D, cm: Costmap2D) -> Velocity2D:
         """LatchedStopRotateController::computeVelocityCommandsStopRotate."""

@@ -350,14 +350,20 @@ def associate_obstacles(
     cutoff_dist: float,
     out_pose: NDArray[np.int64],
     out_obst: NDArray[np.int64],
+    max_forced: int,
 ) -> int:
     """TEB's ``AddEdgesObstacles`` association: for each pose 1..n-2, every obstacle
-    closer than ``force_dist``, plus the closest one on the left and the closest one on
-    the right within ``cutoff_dist``. Returns the number of ``(pose, obstacle)`` pairs."""
+    closer than ``force_dist`` (the ``max_forced`` closest of them: neighbouring costmap
+    cells of one obstacle add near-copies of one edge), plus the closest one on the left
+    and the closest one on the right within ``cutoff_dist``. Returns the number of
+    ``(pose, obstacle)`` pairs."""
     n = poses.shape[0]
     cnt = 0
     cap = out_pose.shape[0]
+    fk = np.empty(max(max_forced, 1), dtype=np.int64)
+    fd = np.empty(max(max_forced, 1))
     for i in range(1, n - 1):
+        nf = 0
         x = poses[i, 0]
         y = poses[i, 1]
         th = poses[i, 2]
@@ -370,10 +376,18 @@ def associate_obstacles(
         for k in range(obstacles.shape[0]):
             d = robot_distance(x, y, th, model, mp, obstacles[k, 0], obstacles[k, 1])
             if d < force_dist:
-                if cnt < cap:
-                    out_pose[cnt] = i
-                    out_obst[cnt] = k
-                    cnt += 1
+                if nf < max_forced:
+                    fk[nf] = k
+                    fd[nf] = d
+                    nf += 1
+                elif max_forced > 0:
+                    worst = 0
+                    for j in range(1, nf):
+                        if fd[j] > fd[worst]:
+                            worst = j
+                    if d < fd[worst]:
+                        fk[worst] = k
+                        fd[worst] = d
                 continue
             if d > cutoff_dist:
                 continue
@@ -384,6 +398,11 @@ def associate_obstacles(
             elif d < dr:
                 dr = d
                 right = k
+        for j in range(nf):
+            if cnt < cap:
+                out_pose[cnt] = i
+                out_obst[cnt] = fk[j]
+                cnt += 1
         if left >= 0 and cnt < cap:
             out_pose[cnt] = i
             out_obst[cnt] = left

@@ -3,7 +3,9 @@ names and defaults) and its ``footprint_model``.
 
 Names of teb_local_planner features roverlab does not implement (homotopy class
 planning, costmap_converter plugins, dynamic obstacles, recovery heuristics,
-visualisation) are accepted with a warning; an unknown name is an error.
+visualisation) are accepted with a warning naming them, and so is an unknown name (ROS
+ignores it). Homotopy class planning is on by default in teb: unless
+``enable_homotopy_class_planning`` is false, a warning says it is not implemented.
 """
 
 from __future__ import annotations
@@ -17,14 +19,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from roverlab.navigation.errors import NavigationParamsError
-from roverlab.navigation.params import build_params, check, flatten_ros
+from roverlab.navigation.params import build_params, check, flatten_ros, unknown_warning
 
 __all__ = ["FOOTPRINT_MODELS", "FootprintModel", "TebParams"]
 
 FOOTPRINT_MODELS = ("point", "circular", "two_circles", "line", "polygon")
 
 _NOT_IMPLEMENTED = (
-    "enable_homotopy_class_planning",
     "enable_multithreading",
     "simple_exploration",
     "max_number_classes",
@@ -56,6 +57,9 @@ _NOT_IMPLEMENTED = (
     "weight_dynamic_obstacle",
     "weight_dynamic_obstacle_inflation",
     "weight_velocity_obstacle_ratio",
+    "obstacle_proximity_ratio_max_vel",
+    "obstacle_proximity_lower_bound",
+    "obstacle_proximity_upper_bound",
     "costmap_converter_plugin",
     "costmap_converter_spin_thread",
     "costmap_converter_rate",
@@ -70,13 +74,27 @@ _NOT_IMPLEMENTED = (
     "divergence_detection_max_chi_squared",
     "publish_feedback",
     "optimization_verbose",
-    "odom_topic",
     "map_frame",
     "legacy_obstacle_association",
     "obstacle_poses_affected",
     "wheelbase",
     "cmd_angle_instead_rotvel",
     "is_footprint_dynamic",
+)
+
+
+_FOOTPRINT_KEYS = frozenset(
+    {
+        "type",
+        "radius",
+        "front_offset",
+        "front_radius",
+        "rear_offset",
+        "rear_radius",
+        "line_start",
+        "line_end",
+        "vertices",
+    }
 )
 
 
@@ -122,20 +140,9 @@ class FootprintModel:
             "line": ("line_start", "line_end"),
             "polygon": ("vertices",),
         }[t]
-        known = {
-            "type",
-            "radius",
-            "front_offset",
-            "front_radius",
-            "rear_offset",
-            "rear_radius",
-            "line_start",
-            "line_end",
-            "vertices",
-        }
-        for key in values:
-            if key not in known:
-                raise NavigationParamsError(f"{w}: unknown parameter {key!r}")
+        unknown = sorted(set(values) - _FOOTPRINT_KEYS)
+        if unknown:  # TebParams.from_ros warns about these and drops them first
+            raise NavigationParamsError(f"{w}: unknown parameter {unknown[0]!r}")
         nums: list[float] = []
         for key in need:
             if key not in values:
@@ -231,11 +238,6 @@ class TebParams:
         check(self.max_samples >= self.min_samples, f"{w}: max_samples must be >= min_samples")
         check(self.max_vel_x > 0, f"{w}: max_vel_x must be > 0")
         check(self.max_vel_x_backwards >= 0, f"{w}: max_vel_x_backwards must be >= 0")
-        check(
-            self.max_vel_y == 0,
-            f"{w}: max_vel_y must be 0: roverlab's TEB plans for differential-drive and "
-            "car-like robots only (holonomic robots are not implemented)",
-        )
         check(self.max_vel_theta > 0, f"{w}: max_vel_theta must be > 0")
         for name in ("acc_lim_x", "acc_lim_theta"):
             check(getattr(self, name) > 0, f"{w}: {name} must be > 0")
@@ -271,14 +273,41 @@ class TebParams:
         Raises:
             NavigationParamsError: an unknown name or a bad value.
         """
+        w = "teb_local_planner"
         flat = flatten_ros(values)
         fp = {k.split("/", 1)[1]: v for k, v in flat.items() if k.startswith("footprint_model/")}
-        rest = {k: v for k, v in flat.items() if not k.startswith("footprint_model/")}
+        rest = {
+            k: v
+            for k, v in flat.items()
+            if not k.startswith(("footprint_model/", "costmap_converter/")) and k != "odom_topic"
+        }
+        warnings: list[str] = []
+        converter = sorted(k for k in flat if k.startswith("costmap_converter/"))
+        if converter:
+            warnings.append(
+                f"{w}: costmap_converter plugins are not implemented by roverlab (each "
+                f"occupied costmap cell is a point obstacle): {', '.join(converter)} ignored"
+            )
+        homotopy = rest.pop("enable_homotopy_class_planning", True)
+        if homotopy is not False:
+            warnings.append(
+                f"{w}: enable_homotopy_class_planning is true (teb's default), but homotopy "
+                "class planning is not implemented by roverlab: one trajectory, started from "
+                "the global plan, is optimised (set it false to silence this warning)"
+            )
+        vy = rest.get("max_vel_y", 0.0)
+        if vy != 0:
+            warnings.append(
+                f"{w}: max_vel_y {vy} ignored: roverlab's TEB plans for differential-drive "
+                "and car-like robots only (holonomic motion is not implemented); max_vel_y 0"
+            )
+            rest["max_vel_y"] = 0.0
+        for key in sorted(set(fp) - _FOOTPRINT_KEYS):
+            warnings.append(unknown_warning(f"{w}: footprint_model", key, _FOOTPRINT_KEYS))
+            fp.pop(key)
         extra = {"footprint_model": FootprintModel.from_ros(fp)} if fp else None
-        p, res = build_params(
-            cls, rest, where="teb_local_planner", ignored=_NOT_IMPLEMENTED, extra=extra
-        )
-        warnings = list(res.warnings)
+        p, res = build_params(cls, rest, where=w, ignored=_NOT_IMPLEMENTED, extra=extra)
+        warnings.extend(res.warnings)
         if p.max_vel_x_backwards <= 0:
             warnings.append(
                 "teb_local_planner: do not choose max_vel_x_backwards to be <= 0; disable "

@@ -33,6 +33,7 @@ import math
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+from scipy.spatial import cKDTree
 
 from roverlab.geometry import SE2, wrap_angle
 from roverlab.navigation.controllers.base import Velocity2D, angle_diff, as_plan, stopped
@@ -52,6 +53,22 @@ from roverlab.navigation.errors import InvalidPathError, NoValidControlError
 __all__ = ["TebPlanner"]
 
 _DT_MIN = 1e-3  # floor of every time difference after a solve
+
+
+#: force-included obstacles kept per pose (the closest): bounds the edges a pose gets
+#: when the obstacles are costmap cells, a dozen of them per post or wall stretch
+_MAX_FORCED_PER_POSE = 8
+
+
+def _model_reach(kind: str, values: NDArray[np.float64]) -> float:
+    """How far the robot model reaches from the pose (m): 0 for a point."""
+    if kind == "circular":
+        return float(values[0])
+    if kind == "two_circles":
+        return float(max(abs(values[0]) + values[1], abs(values[2]) + values[3]))
+    if kind in ("line", "polygon"):
+        return float(np.hypot(values[0::2], values[1::2]).max())
+    return 0.0
 
 
 def _prune(pose: SE2, plan: NDArray[np.float64], dist_behind: float) -> NDArray[np.float64]:
@@ -139,6 +156,7 @@ class TebPlanner:
         self.inscribed_radius = footprint_radii(self.footprint)[0]
         self.band = TimedElasticBand()
         self.obstacles: NDArray[np.float64] = np.zeros((0, 2))
+        self._obstacle_tree: cKDTree | None = None
         self.via_points: NDArray[np.float64] = np.zeros((0, 2))
         self.local_plan: NDArray[np.float64] = np.zeros((0, 3))
         self.goal_reached = False
@@ -193,6 +211,21 @@ class TebPlanner:
         ahead = rel @ [math.cos(pose.theta), math.sin(pose.theta)]
         far = np.hypot(rel[:, 0], rel[:, 1]) > self.params.costmap_obstacles_behind_robot_dist
         return np.ascontiguousarray(obs[~((ahead < 0) & far)])
+
+    def _near_obstacles(self, poses: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The obstacles within the association cutoff of some inner pose of the band (the
+        only ones :func:`associate_obstacles` can pick), found in the cycle's k-d tree:
+        the association's work grows with the band, not with the costmap's cells."""
+        tree = self._obstacle_tree
+        if tree is None or len(poses) < 3:
+            return np.zeros((0, 2))
+        p = self.params
+        reach = p.min_obstacle_dist * max(
+            p.obstacle_association_cutoff_factor, p.obstacle_association_force_inclusion_factor
+        ) + _model_reach(p.footprint_model.type, p.footprint_model.as_array())
+        hits = tree.query_ball_point(poses[1:-1, :2], reach, return_sorted=False)
+        idx = np.unique(np.concatenate([np.asarray(h, dtype=np.int64) for h in hits]))
+        return np.ascontiguousarray(self.obstacles[idx])
 
     def _via_points(self, plan: NDArray[np.float64]) -> NDArray[np.float64]:
         sep = self.params.global_plan_viapoint_sep
@@ -265,20 +298,22 @@ class TebPlanner:
             add(6, pair, dt_none, z2, (p.weight_kinematics_nh, p.weight_kinematics_forward_drive))
         else:
             add(7, pair, dt_none, z2, (p.weight_kinematics_nh, p.weight_kinematics_turning_radius))
-        if p.weight_obstacle > 0 and len(self.obstacles) and n > 2:
-            cap = (n - 2) * (len(self.obstacles) + 2)
+        near = self._near_obstacles(poses)
+        if p.weight_obstacle > 0 and len(near) and n > 2:
+            cap = (n - 2) * (min(len(near), _MAX_FORCED_PER_POSE) + 2)
             op = np.empty(cap, dtype=np.int64)
             oo = np.empty(cap, dtype=np.int64)
             fm = p.footprint_model
             cnt = associate_obstacles(
                 poses,
-                self.obstacles,
+                near,
                 fm.code,
                 fm.as_array(),
                 p.min_obstacle_dist * p.obstacle_association_force_inclusion_factor,
                 p.min_obstacle_dist * p.obstacle_association_cutoff_factor,
                 op,
                 oo,
+                _MAX_FORCED_PER_POSE,
             )
             m = np.full(cnt, -1)
             w_obs = p.weight_obstacle * weight_multiplier
@@ -288,11 +323,11 @@ class TebPlanner:
                     9,
                     one,
                     np.column_stack([m, m]),
-                    self.obstacles[oo[:cnt]],
+                    near[oo[:cnt]],
                     (w_obs, p.weight_inflation),
                 )
             else:
-                add(8, one, np.column_stack([m, m]), self.obstacles[oo[:cnt]], (w_obs,))
+                add(8, one, np.column_stack([m, m]), near[oo[:cnt]], (w_obs,))
         if p.weight_viapoint > 0 and len(self.via_points) and n >= 3:
             rows = []
             start_idx = 0
@@ -493,6 +528,7 @@ class TebPlanner:
         local[0] = pose.as_array()
         self.local_plan = local
         self.obstacles = self._costmap_obstacles(pose, costmap)
+        self._obstacle_tree = cKDTree(self.obstacles) if len(self.obstacles) else None
         if not p.optimization_activate:
             raise NoValidControlError("teb_local_planner: optimization_activate is false")
         start, goal = local[0], local[-1]
