@@ -192,3 +192,42 @@ def test_work_per_cycle_is_bounded_by_the_band_not_the_costmap(teb_params: TebPa
     gaps = near[:, None, :] - band[None, 1:-1, :2]
     dist = np.hypot(gaps[..., 0], gaps[..., 1]).min(axis=1)
     assert 0 < len(near) < len(teb.obstacles) and (dist <= reach + 1e-9).all()
+
+
+def test_feasibility_check_lookahead_distance_replaces_the_pose_count() -> None:
+    """TEB's isTrajectoryFeasible: with ``feasibility_check_lookahead_distance`` set, the
+    check ends at the last pose within that distance, whatever feasibility_check_no_poses
+    says (at 2 m/s the 5 poses of the default reach 3 m ahead, into clutter the band has
+    not yet been optimised around)."""
+    cm = _open()
+    cm.costs[25:35, 38:41] = 254  # a wall across x = 1.9..2.05 m
+    poses = np.column_stack([0.5 + 0.3 * np.arange(8), np.full(8, 1.5), np.zeros(8)])
+
+    def feasible(**kw: float) -> bool:
+        teb = TebPlanner(TebParams(**kw), footprint=FOOT)  # type: ignore[arg-type]
+        teb.band.poses, teb.band.dts = poses.copy(), np.full(7, 0.3)
+        return teb._feasible(cm)
+
+    assert not feasible(feasibility_check_no_poses=5)  # pose 5 (x = 2.0) in the wall
+    assert feasible(feasibility_check_no_poses=5, feasibility_check_lookahead_distance=0.8)
+    assert feasible(feasibility_check_no_poses=2)
+    # the distance replaces the count (TEB sets look_ahead_idx from it)
+    assert not feasible(feasibility_check_no_poses=2, feasibility_check_lookahead_distance=2.0)
+
+
+def test_jackal_teb_model_is_the_padded_costmap_footprint() -> None:
+    """The bundled Jackal file's footprint_model is the costmap's padded footprint (BARN's
+    0.42 x 0.33 m body + footprint_padding 0.1): TEB checks feasibility with the costmap's
+    footprint, so a bare-body model let the band come within the padding of the posts and
+    every BARN world with a tight passage ended in "trajectory is not feasible" at 2 m/s."""
+    import yaml
+
+    from roverlab.description import find_package
+    from roverlab.navigation.costmap import pad_footprint
+
+    path = find_package("robot_navigation") / "param" / "Jackal" / "teb_local_planner_params.yaml"
+    params, _ = TebParams.from_ros(yaml.safe_load(path.read_text())["TebLocalPlannerROS"])
+    body = [[-0.21, -0.165], [-0.21, 0.165], [0.21, 0.165], [0.21, -0.165]]
+    assert params.footprint_model.type == "polygon"
+    model = params.footprint_model.as_array().reshape(-1, 2)
+    np.testing.assert_allclose(model, pad_footprint(body, 0.1))

@@ -184,6 +184,9 @@ class TebParams:
     force_reinit_new_goal_dist: float = 1.0
     force_reinit_new_goal_angular: float = 0.5 * math.pi
     feasibility_check_no_poses: int = 5
+    #: the check ends at the last pose within this distance of the first, whatever
+    #: ``feasibility_check_no_poses`` says (<= 0: not used, TEB's default)
+    feasibility_check_lookahead_distance: float = -1.0
     control_look_ahead_poses: int = 1
     min_resolution_collision_check_angular: float = math.pi
     max_vel_x: float = 0.4

@@ -20,9 +20,11 @@ Per control cycle, as TebLocalPlannerROS::computeVelocityCommands:
   for ``no_inner_iterations`` iterations (:mod:`.solver`: the normal equations of the
   chain are banded, factorised in time linear in the band's length); the obstacle weight
   grows by ``weight_adapt_factor`` each time;
-* the first ``feasibility_check_no_poses`` poses are checked against the costmap with the
-  costmap's footprint; the command is the velocity between the first pose and the next
-  (``control_look_ahead_poses``), saturated to the limits.
+* the first ``feasibility_check_no_poses`` poses (or, when
+  ``feasibility_check_lookahead_distance`` is set, those up to the first pose beyond it)
+  are checked against the costmap with the costmap's footprint; the command is the
+  velocity between the first pose and the next (``control_look_ahead_poses``), saturated
+  to the limits.
 
 Failures raise :class:`NoValidControlError` and reset the band, as TEB clears its planner.
 """
@@ -435,6 +437,13 @@ class TebPlanner:
         look = p.feasibility_check_no_poses
         if look < 0 or look >= len(poses):
             look = len(poses) - 1
+        if p.feasibility_check_lookahead_distance > 0:
+            # as TEB: the pose before the first one farther than the distance is the last
+            # checked (this replaces feasibility_check_no_poses, as in TEB's code)
+            far = np.hypot(poses[1:, 0] - poses[0, 0], poses[1:, 1] - poses[0, 1])
+            beyond = np.nonzero(far > p.feasibility_check_lookahead_distance)[0]
+            if len(beyond):
+                look = int(beyond[0])
         step = self.inscribed_radius if self.inscribed_radius > 0 else cm.resolution
         for i in range(look + 1):
             if self._blocked(cm, *map(float, poses[i])):
