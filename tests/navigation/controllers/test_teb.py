@@ -231,3 +231,5 @@ def test_jackal_teb_model_is_the_padded_costmap_footprint() -> None:
     assert params.footprint_model.type == "polygon"
     model = params.footprint_model.as_array().reshape(-1, 2)
     np.testing.assert_allclose(model, pad_footprint(body, 0.1))
+    # at 2 m/s feasibility_check_no_poses 5 reaches 3 m ahead; the file checks 1 m
+    assert params.feasibility_check_lookahead_distance == 1.0
