@@ -144,6 +144,23 @@ def test_localises_and_publishes_pose_cloud_and_tf(tmp_path: Path) -> None:
     assert late and late[-1] is poses[-1]
 
 
+def test_particle_cloud_is_built_only_for_a_reader(tmp_path: Path) -> None:
+    ctx = Context()
+    MapServer(ctx, yaml_path=_map_file(tmp_path))
+    robot = FakeRobot(ctx)
+    node = AmclNode(ctx, parameter_overrides=START_PARAMS)
+    for k in range(8):
+        robot.truth = SE2(START.x + 0.05 * k, START.y, START.theta)
+        ctx.spin_for(0.25)
+    assert node.amcl is not None and node.amcl.pf.poses.shape[0] >= 100
+    assert node.cloud_publisher.topic.published == 0  # filter updates, nobody listening
+    late: list[Any] = []
+    ctx.create_node("late").create_subscription(mc.PoseArray, "/particlecloud", late.append, 1)
+    ctx.spin_for(0.01)
+    assert len(late) == 1 and late[0].header.frame_id == "map"
+    assert len(late[0].poses) == node.amcl.pf.poses.shape[0]
+
+
 def test_parameters_have_the_ros_names_and_defaults() -> None:
     node = AmclNode(Context())
     for name, value in AmclParams().to_ros().items():

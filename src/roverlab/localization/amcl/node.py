@@ -130,6 +130,7 @@ class AmclNode(Node):
         self._last_scan_frame = ""
         self._last_scan_ns: int | None = None
         self._last_cloud_ns: int | None = None
+        self._cloud_waiting = False  # a cloud was due while nobody listened
         self._last_save_ns = self.get_clock().now_ns()
         self._first_map_received = False
         self._throttle = Throttle(self)
@@ -402,10 +403,29 @@ class AmclNode(Node):
         if rate > 0.0 and last is not None and now - last < round(1e9 / rate):
             return
         self._last_cloud_ns = now
-        poses = self.amcl.pf.poses
+        if not self.cloud_publisher.has_listeners:
+            # a PoseArray of every particle is costly: build it only for a reader; one who
+            # subscribes later gets the current set at once (the topic is latched)
+            if not self._cloud_waiting:
+                self._cloud_waiting = True
+                self.cloud_publisher.when_listened(self._on_cloud_listener)
+            return
+        self._send_cloud()
+
+    def _on_cloud_listener(self) -> None:
+        # the subscriber may be made on another thread: read the particles on the executor's
+        self.context.executor.call_soon_threadsafe(self._cloud_for_listener)
+
+    def _cloud_for_listener(self) -> None:
+        self._cloud_waiting = False
+        if self.amcl is not None:
+            self._send_cloud()
+
+    def _send_cloud(self) -> None:
+        assert self.amcl is not None
         msg = PoseArray(
             header={"frame_id": self.global_frame, "stamp": stamp_to_msg(self.get_clock().now())},
-            poses=poses_from_xytheta(poses),
+            poses=poses_from_xytheta(self.amcl.pf.poses),
         )
         self.cloud_publisher.publish(msg)
 

@@ -274,6 +274,8 @@ class MoveBase(Node):
         return np.column_stack([xy, yaw])
 
     def _publish_path(self, pub: Any, path: np.ndarray, frame: str) -> None:
+        if not pub.has_listeners:  # a Path of every pose each cycle: only for a reader
+            return
         pub.publish(path_to_msg(path, frame, self.get_clock().now()))
 
     # ------------------------------------------------------------------ goals

@@ -46,55 +46,57 @@ def target_distance(
 ) -> None:
     """base_local_planner's ``MapGrid::computeTargetDistance``: a 4-connected wavefront
     from the seed cells (distance 0) counting cells; lethal, inscribed and unknown cells get
-    ``size`` (obstacle) and stop the wave; cells never reached keep ``size + 1``."""
+    ``size`` (obstacle) and stop the wave; cells never reached keep ``size + 1``.
+
+    The wave runs on a copy of the grid with a one-cell border (no bounds checks per
+    neighbour): state 0 free and unseen, 1 an obstacle unseen, 2 seen (or the border).
+    """
     h, w = costs.shape
     size = h * w
-    flat = out.reshape(-1)
-    flat[:] = size + 1
-    mark = np.zeros(size, dtype=np.bool_)
+    pw = w + 2
+    state = np.full((h + 2) * pw, 2, dtype=np.uint8)
+    dist = np.full((h + 2) * pw, size + 1, dtype=np.int64)
+    for y in range(h):
+        row = (y + 1) * pw + 1
+        for x in range(w):
+            c = costs[y, x]
+            state[row + x] = 1 if c >= INSCRIBED else 0  # inscribed, lethal, unknown
     queue = np.empty(size + seeds.shape[0], dtype=np.int64)
     qh = 0
     qt = 0
     for k in range(seeds.shape[0]):
-        idx = seeds[k, 1] * w + seeds[k, 0]
-        flat[idx] = 0.0
-        mark[idx] = True
+        idx = (seeds[k, 1] + 1) * pw + seeds[k, 0] + 1
+        dist[idx] = 0
+        state[idx] = 2
         queue[qt] = idx
         qt += 1
     while qh < qt:
         cur = queue[qh]
         qh += 1
-        cx = cur % w
-        cy = cur // w
+        d = dist[cur] + 1
         for nb in range(4):
             if nb == 0:
-                if cx == 0:
-                    continue
                 n = cur - 1
             elif nb == 1:
-                if cx == w - 1:
-                    continue
                 n = cur + 1
             elif nb == 2:
-                if cy == 0:
-                    continue
-                n = cur - w
+                n = cur - pw
             else:
-                if cy == h - 1:
-                    continue
-                n = cur + w
-            if mark[n]:
+                n = cur + pw
+            st = state[n]
+            if st == 2:
                 continue
-            mark[n] = True
-            c = costs[n // w, n % w]
-            if c in (LETHAL, INSCRIBED, NO_INFO):
-                flat[n] = size
+            state[n] = 2
+            if st == 1:
+                dist[n] = size
                 continue
-            d = flat[cur] + 1.0
-            if d < flat[n]:
-                flat[n] = d
+            dist[n] = d
             queue[qt] = n
             qt += 1
+    for y in range(h):
+        row = (y + 1) * pw + 1
+        for x in range(w):
+            out[y, x] = dist[row + x]
 
 
 @_jit

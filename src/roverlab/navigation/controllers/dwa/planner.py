@@ -82,17 +82,20 @@ def velocity_iterator(lo: float, hi: float, num: int) -> list[float]:
 def _adjust_resolution(plan: NDArray[np.float64], resolution: float) -> NDArray[np.float64]:
     """MapGrid's ``adjustPlanResolution``: points inserted so that none are farther apart
     than ``resolution``."""
+    xy = plan[:, :2]
     if len(plan) < 2:
-        return plan[:, :2]
-    out = [plan[:1, :2]]
-    for a, b in zip(plan[:-1, :2], plan[1:, :2], strict=True):
-        d = float(np.hypot(*(b - a)))
-        if d > resolution:
-            steps = math.ceil(d / resolution)
-            j = np.arange(1, steps)[:, None]
-            out.append(a + j * (b - a) / steps)
-        out.append(b[None, :])
-    return np.concatenate(out)
+        return xy
+    a = xy[:-1]
+    delta = xy[1:] - a
+    d = np.hypot(delta[:, 0], delta[:, 1])
+    steps = np.ones(len(d), dtype=np.int64)
+    far = d > resolution
+    steps[far] = np.ceil(d[far] / resolution).astype(np.int64)
+    # each segment gives its start and steps - 1 points inside (a + j (b - a) / steps)
+    seg = np.repeat(np.arange(len(d)), steps)
+    j = np.arange(len(seg)) - np.repeat(np.cumsum(steps) - steps, steps)
+    inner = a[seg] + j[:, None] * delta[seg] / steps[seg, None]
+    return np.concatenate([inner, xy[-1:]])
 
 
 def _first_known_stretch(plan: NDArray[np.float64], cm: Costmap2D) -> NDArray[np.int64] | None:

@@ -1,0 +1,67 @@
+"""DWA's map grids: the wavefront (MapGrid::computeTargetDistance) and the plan's
+resolution adjustment (MapGrid::adjustPlanResolution) against plain reference versions."""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+
+import numpy as np
+
+from roverlab.navigation.controllers.dwa.kernels import target_distance
+from roverlab.navigation.controllers.dwa.planner import _adjust_resolution
+
+
+def _reference_wave(costs: np.ndarray, seeds: list[tuple[int, int]]) -> np.ndarray:
+    """Breadth-first search cell by cell, as MapGrid does it."""
+    h, w = costs.shape
+    size = h * w
+    out = np.full((h, w), size + 1.0)
+    seen = np.zeros((h, w), dtype=bool)
+    queue: deque[tuple[int, int]] = deque()
+    for x, y in seeds:
+        out[y, x] = 0.0
+        seen[y, x] = True
+        queue.append((x, y))
+    while queue:
+        x, y = queue.popleft()
+        for nx, ny in ((x - 1, y), (x + 1, y), (x, y - 1), (x, y + 1)):
+            if not (0 <= nx < w and 0 <= ny < h) or seen[ny, nx]:
+                continue
+            seen[ny, nx] = True
+            if costs[ny, nx] >= 253:  # inscribed, lethal, unknown
+                out[ny, nx] = size
+                continue
+            out[ny, nx] = out[y, x] + 1.0
+            queue.append((nx, ny))
+    return out
+
+
+def test_target_distance_is_the_breadth_first_wave() -> None:
+    rng = np.random.default_rng(3)
+    values = np.array([0, 40, 252, 253, 254, 255], dtype=np.uint8)
+    for _ in range(40):
+        h, w = (int(v) for v in rng.integers(1, 25, 2))
+        costs = rng.choice(values, size=(h, w), p=[0.55, 0.2, 0.05, 0.07, 0.08, 0.05])
+        n = int(rng.integers(1, 4))
+        seeds = [(int(rng.integers(0, w)), int(rng.integers(0, h))) for _ in range(n)]
+        out = np.empty((h, w))
+        target_distance(costs, np.array(seeds, dtype=np.int64), out)
+        np.testing.assert_array_equal(out, _reference_wave(costs, seeds))
+
+
+def test_adjust_resolution_inserts_even_points_up_to_the_resolution() -> None:
+    rng = np.random.default_rng(4)
+    res = 0.05
+    plan = np.cumsum(rng.normal(scale=0.06, size=(60, 3)), axis=0)
+    out = _adjust_resolution(plan, res)
+    gaps = np.hypot(*np.diff(plan[:, :2], axis=0).T)
+    steps = [math.ceil(d / res) if d > res else 1 for d in gaps]
+    at = np.concatenate([[0], np.cumsum(steps)])
+    assert len(out) == at[-1] + 1
+    np.testing.assert_array_equal(out[at], plan[:, :2])  # every plan point, unchanged
+    spacing = np.hypot(*np.diff(out, axis=0).T)
+    assert spacing.max() <= res + 1e-12
+    for i, k in enumerate(steps):  # the inserted points split each segment evenly
+        np.testing.assert_allclose(spacing[at[i] : at[i + 1]], gaps[i] / k, rtol=1e-9)
+    assert _adjust_resolution(plan[:1], res).shape == (1, 2)
