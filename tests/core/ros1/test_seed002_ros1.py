@@ -72,9 +72,16 @@ def draw_room(folder: Path) -> Path:
 @pytest.mark.slow
 def test_real_rospy_slam_py_patrols_roverlab_navigation(real_master: str, tmp_path: Path) -> None:
     env = {**os.environ, "ROS_MASTER_URI": real_master, "ROS_HOSTNAME": "127.0.0.1"}
+    room = draw_room(tmp_path)
     launch = subprocess.Popen(
-        [sys.executable, "-m", "roverlab.cli", "launch", str(DATA / "seed002_nav.launch")]
-        + [f"map:={draw_room(tmp_path)}", "--rate", "3"],
+        [
+            sys.executable,
+            "-m",
+            "roverlab.cli",
+            "launch",
+            str(DATA / "seed002_nav.launch"),
+            *("--rate", "3", f"map:={room}"),
+        ],
         env=env,
         stdout=subprocess.DEVNULL,
         stderr=(tmp_path / "launch.log").open("w"),
