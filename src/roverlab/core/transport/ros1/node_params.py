@@ -16,7 +16,6 @@ import queue
 import threading
 from typing import TYPE_CHECKING, Any
 
-from roverlab.core.parameters import ParameterType
 from roverlab.core.transport.ros1.errors import MasterError
 from roverlab.core.transport.ros1.xmlrpc import call
 from roverlab.errors import RoverlabError
@@ -49,7 +48,7 @@ class ParamMirror:
         if fq not in self._subscribed:
             self._subscribed.add(fq)
             self._jobs.put(("subscribeParam", (fq, slave_uri, fq.rstrip("/") + "/")))
-        if param.type is not ParameterType.NOT_SET:
+        if param.value is not None:  # declared without a default and not overridden
             self._jobs.put(("setParam", (fq, _key(fq, param.name), param.value)))
 
     def forget(self, node: str, slave_uri: str) -> None:
