@@ -38,6 +38,9 @@ def test_declared_parameters_are_on_the_master_and_rosparam_set_reaches_the_node
         assert get("/param_node/speed") == "0.5"
         assert get("/param_node/mode") == "slow"
         assert get("/param_node/limits/max_range") == "12.0"
+        assert get("/param_node/frame") == "odom"
+        unset = run_ros(real_master, "/usr/bin/rosparam", "get", "/param_node/unset")
+        assert unset.returncode != 0 and "not set" in unset.stderr + unset.stdout
         assert (
             run_ros(real_master, "/usr/bin/rosparam", "set", "/param_node/speed", "0.8").returncode
             == 0

@@ -1,5 +1,6 @@
 """A roverlab node on the ROS 1 graph ROS_MASTER_URI names, with declared parameters
-(``speed`` 0.5, ``mode`` "slow", ``limits.max_range`` 12.0) and a set-parameters callback
+(``speed`` 0.5, ``mode`` "slow", ``limits.max_range`` 12.0; ``frame`` and ``unset``
+without a default, ``frame`` overridden with "odom") and a set-parameters callback
 that refuses a negative speed and prints every change it accepts (``SET name value``).
 Prints READY once the node is registered."""
 
@@ -23,10 +24,12 @@ def on_set(params: list[Any]) -> SetParametersResult:
 ctx = Context(clock="wall")
 transport = Ros1Transport(os.environ["ROS_MASTER_URI"])
 ctx.add_transport(transport)
-node = ctx.create_node("param_node")
+node = ctx.create_node("param_node", parameter_overrides={"frame": "odom"})
 node.declare_parameter("speed", 0.5)
 node.declare_parameter("mode", "slow")
 node.declare_parameter("limits.max_range", 12.0)
+node.declare_parameter("frame", None)  # no default: the override's value
+node.declare_parameter("unset", None)  # no default, no override: not on the master
 node.add_on_set_parameters_callback(on_set)
 print("READY", flush=True)
 try:
