@@ -134,6 +134,14 @@ class Context:
         for t in self.transports:
             t.on_node(node, False)
 
+    def _on_parameter(self, node: Node, param: Any) -> None:
+        """A parameter declared on ``node``: transports that keep a parameter server
+        (ROS 1's master) mirror it there."""
+        for t in self.transports:
+            mirror = getattr(t, "on_parameter", None)
+            if mirror is not None:
+                mirror(node, param)
+
     def _on_publisher(self, pub: Publisher) -> None:
         for t in self.transports:
             t.on_publisher(pub, True)

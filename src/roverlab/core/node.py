@@ -470,6 +470,7 @@ class Node:
             except ParameterError as err:
                 raise ParameterError(f"node '{self._name}': {err}") from err
         self._parameters[name] = param
+        self.context._on_parameter(self, param)
         return param
 
     def declare_parameters(

@@ -38,6 +38,7 @@ from roverlab.msgs import (
     PointStamped,
     PoseStamped,
     PoseWithCovarianceStamped,
+    String,
     image_to_array,
     occupancy_grid_to_array,
     pose_from_xytheta,
@@ -305,6 +306,22 @@ class VizBridge(DisplayStatus):
             self._description_sub = self.node.create_subscription(
                 "std_msgs/msg/String", topic, self._on_description, _LATCHED
             )
+            self._description_from_master(topic)
+
+    def _description_from_master(self, name: str) -> None:
+        """On a ROS 1 graph the robot description is the master's parameter of that name
+        (as rviz's RobotModel reads it), not a topic: read it once from there."""
+        for transport in self.node.context.transports:
+            get_param = getattr(transport, "get_param", None)
+            if get_param is None:
+                continue
+            text = get_param(name, None)
+            if isinstance(text, str) and text.strip():
+                try:
+                    self._on_description(String(data=text))
+                except (RoverlabError, ValueError) as err:
+                    self.node.get_logger().warning(f"robot description {name}: {err}")
+                return
 
     def _subscribe(self, state: DisplayState, key: tuple[str, str]) -> Any:
         topic, typename = key

@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any
 
 from roverlab.core.errors import ServiceError
 from roverlab.core.transport.ros1.errors import MasterError
+from roverlab.core.transport.ros1.node_params import ParamMirror
 from roverlab.core.transport.ros1.peer import Ros1Peer, TopicSpec
 from roverlab.core.transport.ros1.service_link import (
     ServiceCallError,
@@ -34,6 +35,7 @@ if TYPE_CHECKING:
     from roverlab.core.context import Context
     from roverlab.core.graph import Topic
     from roverlab.core.node import Node, Publisher, Subscription
+    from roverlab.core.parameters import Parameter
     from roverlab.core.services import Client, Future, Service
 
 _MISSING: Any = object()
@@ -114,6 +116,10 @@ class Ros1Transport:
     def __init__(self, master_uri: str) -> None:
         self.master_uri = master_uri
         self.peer = Ros1Peer(master_uri)
+        self.params = ParamMirror(master_uri)
+        self.peer.on_param = lambda node, key, value: self.params.update(
+            self._context, node, key, value
+        )
         self._context: Context | None = None
         self._specs: dict[str, TopicSpec] = {}
         self.received = 0
@@ -133,6 +139,9 @@ class Ros1Transport:
     # ----------------------------------------------------------------- Transport protocol
     def attach(self, context: Context) -> None:
         self._context = context
+        for node in list(context.nodes.values()):  # declared before the transport came
+            for param in list(node.parameters.values()):
+                self.on_parameter(node, param)
         if context.uses_sim_time:  # as Gazebo does: ROS 1 nodes follow our /clock
             try:
                 call(self.master_uri, "setParam", "/roverlab", "/use_sim_time", True)
@@ -144,7 +153,12 @@ class Ros1Transport:
         if added:
             self.peer.add_node(fq)
         else:
+            self.params.forget(fq, self.peer.add_node(fq))
             self.peer.remove_node(fq)
+
+    def on_parameter(self, node: Node, param: Parameter) -> None:
+        """A parameter declared on ``node``: mirrored to the master's parameter server."""
+        self.params.declared(node, param, self.peer.add_node(node.get_fully_qualified_name()))
 
     def on_publisher(self, pub: Publisher, added: bool) -> None:
         topic = pub.topic
@@ -334,4 +348,5 @@ class Ros1Transport:
         return True
 
     def close(self) -> None:
+        self.params.close()
         self.peer.close()
