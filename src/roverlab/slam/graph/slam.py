@@ -62,6 +62,7 @@ from roverlab.slam.common import ScanLike
 from roverlab.slam.data.pose_solver import optimize
 from roverlab.slam.data.posegraph import PoseGraph
 from roverlab.slam.data.trajectory import Trajectory
+from roverlab.slam.degeneracy import scan_constraint
 from roverlab.slam.graph.errors import GraphSlamInputError
 from roverlab.slam.graph.loops import _OPT_ITERATIONS, LoopClosing
 from roverlab.slam.graph.matcher import (
@@ -179,6 +180,7 @@ class GraphSLAM(LoopClosing):
         self._kf_odom = np.zeros((0, 3))
         self._kf_scan_index: list[int] = []
         self._kf_scans: list[_Scan] = []
+        self._kf_weak: list[FloatArray | None] = []  # a degenerate keyframe's weak direction
         self._kf_prev_rel = np.zeros((0, 3))  # pose of keyframe k in keyframe k-1 at creation
         self._e_from: list[int] = []
         self._e_to: list[int] = []
@@ -196,6 +198,7 @@ class GraphSLAM(LoopClosing):
         self.rejected_loop_closures = 0
         self.optimisations = 0
         self.rim_searches = 0
+        self.degenerate_scans = 0
         self.last_response = 0.0
 
     @property
@@ -300,7 +303,7 @@ class GraphSLAM(LoopClosing):
             self._all_scans.append(scan)
         if self._last_pose is None or self._last_odom is None:
             pose = odom.copy()
-            self._add_keyframe(pose, odom, scan, None)
+            self._add_keyframe(pose, odom, scan, None, None)
             pose = self._kf_pose[-1].copy()
         else:
             pred = _compose(self._last_pose, _relative(self._last_odom, odom))
@@ -311,16 +314,23 @@ class GraphSLAM(LoopClosing):
                 or abs(d_odom[2]) >= p.minimum_travel_heading
             )
             result: MatchResult | None = None
+            weak: FloatArray | None = None
+            cov: FloatArray | None = None
             if p.use_scan_matching and pts.shape[0] >= 3 and self._grid is not None:
                 result = self._match_sequential(self._grid, pts, pred, penalise=True, cov=keyframe)
                 result = self._beyond_the_rim(self._grid, pts, pred, result, keyframe)
-                pose = result.pose
+                pose, cov = result.pose, result.covariance
                 self.last_response = result.response
+                if p.degenerate_eigen_ratio > 0.0:
+                    ratio, direction = scan_constraint(pts)
+                    if ratio < p.degenerate_eigen_ratio:
+                        weak = direction
+                        self.degenerate_scans += 1
+                        pose, cov = self._keep_odometry(weak, pose, pred, cov)
             else:
                 pose = pred
             if keyframe:
-                cov = result.covariance if result is not None else None
-                self._add_keyframe(pose, odom, scan, cov)
+                self._add_keyframe(pose, odom, scan, cov, weak)
                 pose = self._kf_pose[-1].copy()
         k = self.num_keyframes - 1
         self._scan_ref.append(k)
@@ -407,10 +417,16 @@ class GraphSLAM(LoopClosing):
 
     # ---------------------------------------------------------------- graph building
     def _add_keyframe(
-        self, pose: FloatArray, odom: FloatArray, scan: _Scan, cov: FloatArray | None
+        self,
+        pose: FloatArray,
+        odom: FloatArray,
+        scan: _Scan,
+        cov: FloatArray | None,
+        weak: FloatArray | None,
     ) -> None:
         p = self.params
         k = self.num_keyframes
+        self._kf_weak.append(weak)
         prev_rel = np.zeros(3) if k == 0 else _relative(self._kf_pose[k - 1], pose)
         self._kf_pose = np.vstack([self._kf_pose, pose[None, :]])
         self._kf_odom = np.vstack([self._kf_odom, odom[None, :]])

@@ -31,7 +31,8 @@ from roverlab.geometry import SE2, wrap_angle
 from roverlab.maps.grid import scan_arrays
 from roverlab.slam.common import ScanLike
 from roverlab.slam.data.trajectory import Trajectory
-from roverlab.slam.hector.degeneracy import map_values, scan_constraint
+from roverlab.slam.degeneracy import odometry_along, scan_constraint
+from roverlab.slam.hector.degeneracy import map_values
 from roverlab.slam.hector.errors import HectorInputError, OutOfMapError
 from roverlab.slam.hector.grid import HectorMap, MultiResGrid
 from roverlab.slam.hector.matcher import match
@@ -327,11 +328,7 @@ class HectorSLAM:
             # only surfaces the map already holds fix the robot against the map
             ratio, weak = scan_constraint(pts, values > _OCCUPIED_ABOVE)
             if ratio < p.degenerate_eigen_ratio:
-                c, s = math.cos(pose[2]), math.sin(pose[2])
-                vx, vy = c * weak[0] - s * weak[1], s * weak[0] + c * weak[1]
-                along = (predicted[0] - pose[0]) * vx + (predicted[1] - pose[1]) * vy
-                pose[0] += along * vx
-                pose[1] += along * vy
+                pose = odometry_along(pose, predicted, weak)
                 self.guard_counts.degenerate += 1
                 values = map_values(prob, k, centre, pose, pts)
         if p.max_free_endpoints < 1.0 and pts.shape[0]:
