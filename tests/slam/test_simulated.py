@@ -9,6 +9,7 @@ estimate stays within 0.1 m of the ground truth.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import subprocess
 import sys
@@ -20,7 +21,7 @@ from typer.testing import CliRunner
 
 from roverlab.cli import slam as slam_cli
 from roverlab.cli import slam_run
-from roverlab.cli.slam_run import run_graph, run_hector
+from roverlab.cli.slam_run import run_gmapping, run_graph, run_hector
 from roverlab.geometry import SE2
 from roverlab.slam.data import evaluate, load_log, read_relations, read_tum
 from roverlab.slam.data.scans import LaserLog, ScanRecord
@@ -171,6 +172,35 @@ def test_a_runaway_stops_with_one_warning_naming_the_jump(
     assert "ran away" in warnings[0]
     assert len(res.trajectory) == k
     assert (res.data == 100).any()
+
+
+@pytest.mark.parametrize("method", ["graph", "gmapping"])
+def test_a_graph_or_gmapping_runaway_stops_with_one_warning_naming_the_jump(method: str) -> None:
+    """Item 4 for graph SLAM and gmapping: odometry that teleports 1 km puts the estimate
+    beyond any building (400 m); the run stops before that scan with one warning naming its
+    log time, and the map and trajectory hold the scans before it (before: the map grew to
+    1 km)."""
+    sim = simulate(building("corridor", 20.0), laser=LASERS["360"], noise=NOISE_LEVELS["none"],
+                   rng=np.random.default_rng(1), scan_rate_hz=2.0)  # fmt: skip
+    k = 20
+    jump = SE2(1000.0, 0.0, 0.0)
+    records = [
+        r if i < k else dataclasses.replace(r, odom_pose=jump * r.odom_pose)
+        for i, r in enumerate(sim.log)
+    ]
+    log = LaserLog(records, source="teleport")
+    if method == "graph":
+        res = run_graph(log, {})
+    else:
+        res = run_gmapping(log, {"particles": 5}, seed=0, smooth=True)
+    warnings = [n for n in res.notes if n.startswith("warning:")]
+    assert len(warnings) == 1
+    assert f"{records[k].timestamp:.3f}" in warnings[0]
+    assert f"{method}'s estimate ran away" in warnings[0]
+    assert len(res.trajectory) == k
+    assert (res.data == 100).any()
+    # graph's map spans what it saw; gmapping's at least its xmin..xmax box (200 m)
+    assert res.data.shape[1] * res.resolution <= {"graph": 40.0, "gmapping": 200.0}[method]
 
 
 def test_slam_simulate_then_slam_run_says_it_uses_the_odometry(tmp_path: Path) -> None:

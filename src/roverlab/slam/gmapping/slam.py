@@ -54,7 +54,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from roverlab.geometry import SE2
 from roverlab.maps.grid import scan_arrays
-from roverlab.slam.common import ScanLike
+from roverlab.slam.common import Runaway, RunawayWatch, ScanLike
 from roverlab.slam.gmapping import kernels
 from roverlab.slam.gmapping.errors import GMappingInputError
 from roverlab.slam.gmapping.grid import GMappingMap, ParticleMaps
@@ -199,6 +199,7 @@ class GMapping(ScanMatching):
         self.history: list[UpdateInfo] = []
         self.resamples = 0
         self.recoveries = 0
+        self.runaway: Runaway | None = None
 
     @property
     def updates(self) -> int:
@@ -341,7 +342,13 @@ class GMapping(ScanMatching):
         self._update(beams, odom, t)
         return True
 
-    def run_log(self, log: Iterable[ScanLike], *, interpolate: bool = False) -> GMappingRun:
+    def run_log(
+        self,
+        log: Iterable[ScanLike],
+        *,
+        interpolate: bool = False,
+        max_extent_m: float = math.inf,
+    ) -> GMappingRun:
         """Process every scan of a laser log (``roverlab.slam.data.logs.LaserLog``) in order.
 
         Each record's ``laser_offset`` places the laser on the robot. Returns one robot pose
@@ -356,13 +363,23 @@ class GMapping(ScanMatching):
                 had come between the two updates (travel over ``linearUpdate`` plus turn
                 over ``angularUpdate``); so the correction the next update makes is spread
                 over the scans before it instead of appearing as a jump.
+            max_extent_m: a scan whose predicted pose (the best particle's at the last
+                update moved by the odometry since) lies farther than this from the first
+                one along x or y has run away: the run stops before it, :attr:`runaway` says
+                where, and the map and poses hold the scans before it (default: never).
         """
         stamps: list[float] = []
         odoms: list[NDArray[np.float64]] = []
         after: list[int] = []  # index of the last update at or before each scan
         update_scans: list[int] = []  # scan index of each update
         first = self.updates
-        for rec in log:
+        self.runaway = None
+        watch = RunawayWatch(max_extent_m, "gmapping")
+        for k, rec in enumerate(log):
+            pred = self.map_to_odom() * rec.odom_pose
+            self.runaway = watch.check(k, float(rec.timestamp), pred.x, pred.y)
+            if self.runaway is not None:
+                break
             ranges = np.asarray(rec.ranges)
             angles = rec.angle_min + rec.angle_increment * np.arange(ranges.size)
             odom = _odom_array(rec.odom_pose)

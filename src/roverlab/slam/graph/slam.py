@@ -58,7 +58,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from roverlab.geometry import SE2
 from roverlab.maps.grid import CountGrid, scan_arrays
-from roverlab.slam.common import ScanLike
+from roverlab.slam.common import Runaway, RunawayWatch, ScanLike
 from roverlab.slam.data.pose_solver import optimize
 from roverlab.slam.data.posegraph import PoseGraph
 from roverlab.slam.data.trajectory import Trajectory
@@ -199,6 +199,7 @@ class GraphSLAM(LoopClosing):
         self.optimisations = 0
         self.rim_searches = 0
         self.degenerate_scans = 0
+        self.runaway: Runaway | None = None
         self.last_response = 0.0
 
     @property
@@ -555,11 +556,25 @@ class GraphSLAM(LoopClosing):
         return GraphMap(data, res, grid.origin_xy)
 
     # ---------------------------------------------------------------- batch
-    def run_log(self, log: Iterable[ScanLike]) -> GraphRun:
+    def run_log(self, log: Iterable[ScanLike], *, max_extent_m: float = math.inf) -> GraphRun:
         """Process every scan of a laser log (a ``roverlab.slam.data.LaserLog``) in order, then
-        optimise the graph once more and return one final pose per scan and the map."""
+        optimise the graph once more and return one final pose per scan and the map.
+
+        Args:
+            log: the scans.
+            max_extent_m: a scan whose predicted pose (the latest estimate moved by the
+                odometry) lies farther than this from the first pose along x or y has run
+                away: the run stops before it, :attr:`runaway` says where, and the map and
+                poses hold the scans before it (default: never).
+        """
         stamps: list[str] = []
-        for rec in log:
+        self.runaway = None
+        watch = RunawayWatch(max_extent_m, "graph")
+        for k, rec in enumerate(log):
+            pred = self.map_to_odom() * rec.odom_pose
+            self.runaway = watch.check(k, float(rec.timestamp), pred.x, pred.y)
+            if self.runaway is not None:
+                break
             ranges = np.asarray(rec.ranges)
             angles = rec.angle_min + rec.angle_increment * np.arange(ranges.size)
             self.process(
