@@ -55,6 +55,7 @@ from numpy.typing import ArrayLike, NDArray
 from roverlab.geometry import SE2
 from roverlab.maps.grid import scan_arrays
 from roverlab.slam.common import Runaway, RunawayWatch, ScanLike
+from roverlab.slam.degeneracy import odometry_along, scan_constraint
 from roverlab.slam.gmapping import kernels
 from roverlab.slam.gmapping.errors import GMappingInputError
 from roverlab.slam.gmapping.grid import GMappingMap, ParticleMaps
@@ -142,6 +143,11 @@ class GMapping(ScanMatching):
             call of :meth:`process` may override it.
         recover_odometry_failures: search widely when every particle's scan match fails
             (see the module docstring); ``False`` is plain gmapping.
+        degenerate_eigen_ratio: (roverlab) a scan whose surface normals' eigenvalue ratio
+            is below this (a bare corridor: :func:`roverlab.slam.degeneracy.scan_constraint`)
+            cannot fix the robot along its weak direction: there each particle's match keeps
+            the particle's own (odometry-sampled) position; 0 is plain gmapping (its matcher
+            slips back along a corridor).
 
     Attributes:
         history: one :class:`UpdateInfo` per filter update (Neff, resampled or not).
@@ -157,9 +163,12 @@ class GMapping(ScanMatching):
         *,
         laser_offset: SE2 = _NO_OFFSET,
         recover_odometry_failures: bool = True,
+        degenerate_eigen_ratio: float = 0.01,
     ) -> None:
         self.params = params if params is not None else GMappingParams()
         self.recover_odometry_failures = bool(recover_odometry_failures)
+        self.degenerate_eigen_ratio = float(degenerate_eigen_ratio)
+        self.degenerate_updates = 0
         if isinstance(rng, np.random.Generator):
             self._rng = rng
         else:
@@ -463,6 +472,12 @@ class GMapping(ScanMatching):
             best = int(np.argmax(scores))
             if self.recover_odometry_failures and scores[best] < _RECOVER_BELOW * n_beams:
                 self._recover(beams, best, matched, scores)
+            if self.degenerate_eigen_ratio > 0.0:
+                ratio, weak = scan_constraint(beams.hit)
+                if ratio < self.degenerate_eigen_ratio:
+                    self.degenerate_updates += 1
+                    pairs = zip(matched, self._poses, strict=True)
+                    matched = np.array([odometry_along(m, q, weak) for m, q in pairs])
             centers = np.where((scores > p.minimumScore)[:, None], matched, self._poses)
         else:
             centers = self._poses
