@@ -177,8 +177,9 @@ def test_a_runaway_stops_with_one_warning_naming_the_jump(
 
 def test_gmapping_keeps_the_odometry_along_a_bare_corridor(corridor: SimulatedLog) -> None:
     """gmapping's hill climbing slips back along a bare corridor too (plain gmapping,
-    ``degenerate_eigen_ratio=0``: 0.8 m behind); keeping each particle's odometry-sampled
-    position along the scan's weak direction stays within 0.3 m (the odometry's drift)."""
+    ``degenerate_eigen_ratio=0``, the default: 0.8 m behind); keeping each particle's
+    odometry-sampled position along the scan's weak direction stays within 0.3 m (the
+    odometry's drift)."""
     errs = []
     for ratio in (0.0, 0.01):
         slam = GMapping(GMappingParams(particles=10), rng=np.random.default_rng(0),

@@ -146,8 +146,9 @@ class GMapping(ScanMatching):
         degenerate_eigen_ratio: (roverlab) a scan whose surface normals' eigenvalue ratio
             is below this (a bare corridor: :func:`roverlab.slam.degeneracy.scan_constraint`)
             cannot fix the robot along its weak direction: there each particle's match keeps
-            the particle's own (odometry-sampled) position; 0 is plain gmapping (its matcher
-            slips back along a corridor).
+            the particle's own (odometry-sampled) position; 0 (the default) is plain
+            gmapping, whose matcher slips back along a corridor. Off by default: 0.01 gives
+            0.0394 m on intel (seed 0, plain 0.0379), fr079 unchanged.
 
     Attributes:
         history: one :class:`UpdateInfo` per filter update (Neff, resampled or not).
@@ -163,7 +164,7 @@ class GMapping(ScanMatching):
         *,
         laser_offset: SE2 = _NO_OFFSET,
         recover_odometry_failures: bool = True,
-        degenerate_eigen_ratio: float = 0.01,
+        degenerate_eigen_ratio: float = 0.0,
     ) -> None:
         self.params = params if params is not None else GMappingParams()
         self.recover_odometry_failures = bool(recover_odometry_failures)
