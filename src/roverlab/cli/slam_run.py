@@ -40,17 +40,36 @@ METHODS = ("hector", "gmapping", "graph")
 _HECTOR_MARGIN_M = 5.0
 _HECTOR_MARGIN_SHARE = 0.15
 _HECTOR_GROW_MAX = 8192  # cells per side: 1 GB for three levels
-_HECTOR_PLAUSIBLE_MARGIN_M = 50.0  # a building is at most twice the odometry's box + this
+_PLAUSIBLE_MARGIN_M = 50.0  # a building is at most twice the odometry's box + this
+_PLAUSIBLE_MAX_M = 400.0  # and no building is larger (hector's largest map: 8192 * 5 cm)
+
+
+def plausible_extent_m(records: LaserLog) -> float:
+    """How far (m) from its start an estimate can be before it has run away: twice the
+    odometry's extent plus 50 m (no drift makes a building bigger than that), at most
+    :data:`_PLAUSIBLE_MAX_M` (odometry that jumps must not make a building of any size);
+    that for a log without odometry."""
+    if not _has_odometry(records):
+        return _PLAUSIBLE_MAX_M
+    extent = float(np.ptp(records.odom_poses[:, :2], axis=0).max())
+    return min(2.0 * extent + _PLAUSIBLE_MARGIN_M, _PLAUSIBLE_MAX_M)
 
 
 def run_graph(records: LaserLog, params: dict[str, object]) -> MethodResult:
     slam = GraphSLAM(GraphParams.from_ros(params))
-    result = slam.run_log(progress(records, "graph"))
+    result = slam.run_log(progress(records, "graph"), max_extent_m=plausible_extent_m(records))
     m = result.map
     g = slam.graph()
     notes = [f"graph: {g.num_vertices} keyframes, {g.num_edges} constraints"]
     if slam.rim_searches:
         notes[0] += f", {slam.rim_searches} matches searched again beyond the angular window"
+    if slam.degenerate_scans:
+        notes[0] += (
+            f", {slam.degenerate_scans} scans degenerate along a corridor kept the odometry "
+            "along it"
+        )
+    if slam.runaway is not None:
+        notes.append(slam.runaway.warning())
     dropped = sorted(k for k in params if k in NODE_PARAMETERS)
     if dropped:  # GraphParams.from_ros accepts slam_toolbox's node settings and drops them
         notes.append(
@@ -149,7 +168,7 @@ def hector_plausible_cells(records: LaserLog, hp: HectorParams) -> int:
     if not _has_odometry(records):
         return max(hp.map_size, _HECTOR_GROW_MAX)
     extent = float(np.ptp(records.odom_poses[:, :2], axis=0).max())
-    need = (2.0 * extent + _HECTOR_PLAUSIBLE_MARGIN_M) / hp.map_resolution
+    need = (2.0 * extent + _PLAUSIBLE_MARGIN_M) / hp.map_resolution
     cells = hp.map_size
     while cells < need and 2 * cells <= _HECTOR_GROW_MAX:
         cells *= 2
@@ -195,13 +214,20 @@ def run_gmapping(
     records: LaserLog, params: dict[str, object], *, seed: int, smooth: bool
 ) -> MethodResult:
     slam = GMapping(GMappingParams.from_ros(params), rng=np.random.default_rng(seed))
-    result = slam.run_log(progress(records, "gmapping"), interpolate=smooth)
+    result = slam.run_log(
+        progress(records, "gmapping"),
+        interpolate=smooth,
+        max_extent_m=plausible_extent_m(records),
+    )
     m = result.map
-    traj = Trajectory.from_poses(list(records.timestamp_texts), result.poses)
+    stamps = list(records.timestamp_texts)[: len(result.poses)]
+    traj = Trajectory.from_poses(stamps, result.poses)
     notes = [
         f"gmapping: {slam.updates} filter updates, {slam.resamples} resamplings, "
         f"{slam.recoveries} odometry-failure recoveries"
     ]
+    if slam.runaway is not None:
+        notes.append(slam.runaway.warning())
     return MethodResult(m.data, m.resolution, m.origin_xy, result.poses, traj, notes)
 
 

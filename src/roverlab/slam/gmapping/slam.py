@@ -54,7 +54,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from roverlab.geometry import SE2
 from roverlab.maps.grid import scan_arrays
-from roverlab.slam.common import ScanLike
+from roverlab.slam.common import Runaway, RunawayWatch, ScanLike
+from roverlab.slam.degeneracy import odometry_along, scan_constraint
 from roverlab.slam.gmapping import kernels
 from roverlab.slam.gmapping.errors import GMappingInputError
 from roverlab.slam.gmapping.grid import GMappingMap, ParticleMaps
@@ -142,6 +143,12 @@ class GMapping(ScanMatching):
             call of :meth:`process` may override it.
         recover_odometry_failures: search widely when every particle's scan match fails
             (see the module docstring); ``False`` is plain gmapping.
+        degenerate_eigen_ratio: (roverlab) a scan whose surface normals' eigenvalue ratio
+            is below this (a bare corridor: :func:`roverlab.slam.degeneracy.scan_constraint`)
+            cannot fix the robot along its weak direction: there each particle's match keeps
+            the particle's own (odometry-sampled) position; 0 (the default) is plain
+            gmapping, whose matcher slips back along a corridor. Off by default: 0.01 gives
+            0.0394 m on intel (seed 0, plain 0.0379), fr079 unchanged.
 
     Attributes:
         history: one :class:`UpdateInfo` per filter update (Neff, resampled or not).
@@ -157,9 +164,12 @@ class GMapping(ScanMatching):
         *,
         laser_offset: SE2 = _NO_OFFSET,
         recover_odometry_failures: bool = True,
+        degenerate_eigen_ratio: float = 0.0,
     ) -> None:
         self.params = params if params is not None else GMappingParams()
         self.recover_odometry_failures = bool(recover_odometry_failures)
+        self.degenerate_eigen_ratio = float(degenerate_eigen_ratio)
+        self.degenerate_updates = 0
         if isinstance(rng, np.random.Generator):
             self._rng = rng
         else:
@@ -199,6 +209,7 @@ class GMapping(ScanMatching):
         self.history: list[UpdateInfo] = []
         self.resamples = 0
         self.recoveries = 0
+        self.runaway: Runaway | None = None
 
     @property
     def updates(self) -> int:
@@ -341,7 +352,13 @@ class GMapping(ScanMatching):
         self._update(beams, odom, t)
         return True
 
-    def run_log(self, log: Iterable[ScanLike], *, interpolate: bool = False) -> GMappingRun:
+    def run_log(
+        self,
+        log: Iterable[ScanLike],
+        *,
+        interpolate: bool = False,
+        max_extent_m: float = math.inf,
+    ) -> GMappingRun:
         """Process every scan of a laser log (``roverlab.slam.data.logs.LaserLog``) in order.
 
         Each record's ``laser_offset`` places the laser on the robot. Returns one robot pose
@@ -356,13 +373,23 @@ class GMapping(ScanMatching):
                 had come between the two updates (travel over ``linearUpdate`` plus turn
                 over ``angularUpdate``); so the correction the next update makes is spread
                 over the scans before it instead of appearing as a jump.
+            max_extent_m: a scan whose predicted pose (the best particle's at the last
+                update moved by the odometry since) lies farther than this from the first
+                one along x or y has run away: the run stops before it, :attr:`runaway` says
+                where, and the map and poses hold the scans before it (default: never).
         """
         stamps: list[float] = []
         odoms: list[NDArray[np.float64]] = []
         after: list[int] = []  # index of the last update at or before each scan
         update_scans: list[int] = []  # scan index of each update
         first = self.updates
-        for rec in log:
+        self.runaway = None
+        watch = RunawayWatch(max_extent_m, "gmapping")
+        for k, rec in enumerate(log):
+            pred = self.map_to_odom() * rec.odom_pose
+            self.runaway = watch.check(k, float(rec.timestamp), pred.x, pred.y)
+            if self.runaway is not None:
+                break
             ranges = np.asarray(rec.ranges)
             angles = rec.angle_min + rec.angle_increment * np.arange(ranges.size)
             odom = _odom_array(rec.odom_pose)
@@ -446,6 +473,12 @@ class GMapping(ScanMatching):
             best = int(np.argmax(scores))
             if self.recover_odometry_failures and scores[best] < _RECOVER_BELOW * n_beams:
                 self._recover(beams, best, matched, scores)
+            if self.degenerate_eigen_ratio > 0.0:
+                ratio, weak = scan_constraint(beams.hit)
+                if ratio < self.degenerate_eigen_ratio:
+                    self.degenerate_updates += 1
+                    pairs = zip(matched, self._poses, strict=True)
+                    matched = np.array([odometry_along(m, q, weak) for m, q in pairs])
             centers = np.where((scores > p.minimumScore)[:, None], matched, self._poses)
         else:
             centers = self._poses

@@ -18,6 +18,7 @@ from scipy.sparse.csgraph import breadth_first_order
 
 from roverlab.slam.data.pose_solver import optimize
 from roverlab.slam.data.posegraph import PoseGraph, edge_errors
+from roverlab.slam.degeneracy import odometry_along
 from roverlab.slam.graph.matcher import CorrelationGrid, MatchResult, build_grid, match_scan
 from roverlab.slam.graph.params import GraphParams
 from roverlab.slam.graph.poses import _information, _relative, _runs, _Scan
@@ -38,6 +39,7 @@ class LoopClosing:
     params: GraphParams
     _kf_pose: FloatArray
     _kf_scans: list[_Scan]
+    _kf_weak: list[FloatArray | None]
     _e_from: list[int]
     _e_to: list[int]
     _e_meas: list[FloatArray]
@@ -84,6 +86,21 @@ class LoopClosing:
         self._e_meas.append(_relative(self._kf_pose[i], mean_j))
         self._e_info.append(_information(cov, float(mean_j[2])))
         self._e_kind.append(kind)
+
+    def _keep_odometry(
+        self, weak: FloatArray | None, pose: FloatArray, pred: FloatArray, cov: FloatArray
+    ) -> tuple[FloatArray, FloatArray]:
+        """A degenerate scan's match (``weak``: the robot-frame direction its scan cannot
+        fix, None if it can) keeps ``pred``'s position along ``weak``, and its covariance
+        grows by ``degenerate_variance`` along it."""
+        if weak is None:
+            return pose, cov
+        fixed = odometry_along(pose, pred, weak)
+        c, s = np.cos(fixed[2]), np.sin(fixed[2])
+        w = np.array([c * weak[0] - s * weak[1], s * weak[0] + c * weak[1]])
+        loose = np.array(cov, dtype=np.float64, copy=True)
+        loose[:2, :2] += self.params.degenerate_variance * np.outer(w, w)
+        return fixed, loose
 
     def _closest(self, frames: list[int] | NDArray[np.intp], pose: FloatArray) -> int:
         idx = np.asarray(frames, dtype=np.intp)
@@ -134,8 +151,12 @@ class LoopClosing:
             chain = list(range(a, b))
             res = self._chain_grid_match(k, chain, self._kf_pose[k], cov=True)
             if res.response > p.link_match_minimum_response_fine - 1e-9:
-                self._add_edge(self._closest(chain, res.pose), k, res.pose, res.covariance, "near")
-                out.append((res.pose, res.covariance))
+                # a corridor scan matches its chain anywhere along the corridor
+                mean, cov = self._keep_odometry(
+                    self._kf_weak[k], res.pose, self._kf_pose[k], res.covariance
+                )
+                self._add_edge(self._closest(chain, mean), k, mean, cov, "near")
+                out.append((mean, cov))
         return out
 
     def _loop_chains(self, k: int) -> list[list[int]]:
@@ -156,8 +177,12 @@ class LoopClosing:
         return chains
 
     def _try_close_loop(self, k: int) -> None:
-        """Karto's ``TryCloseLoop`` plus an optimisation and a consistency check."""
+        """Karto's ``TryCloseLoop`` plus an optimisation and a consistency check; a
+        degenerate scan (a bare corridor's) closes no loop: it would match anywhere along
+        the corridor."""
         p = self.params
+        if self._kf_weak[k] is not None:
+            return
         added = 0
         backup = self._kf_pose.copy()
         n_edges = len(self._e_from)

@@ -123,6 +123,14 @@ class GraphParams:
         map_scans: (roverlab) which scans the occupancy map is rendered from:
             ``"keyframes"`` (Karto: the graph's vertices) or ``"all"`` (every scan, at its
             final pose).
+        degenerate_eigen_ratio: (roverlab) a scan whose surface normals' information has
+            an eigenvalue ratio below this (a bare corridor:
+            :func:`roverlab.slam.degeneracy.scan_constraint`) cannot fix the robot along its
+            weak direction: there the sequential and near-chain matches keep the odometry's
+            position, their edges are loose along it (``degenerate_variance``), and the scan
+            closes no loop. 0 turns it off (Karto's behaviour: the match stalls).
+        degenerate_variance: (roverlab) variance added along the weak direction to the
+            edges of a degenerate scan (m^2).
     """
 
     resolution: float = 0.05
@@ -162,6 +170,8 @@ class GraphParams:
     scan_match_refinement: bool = True
     loop_closure_max_residual: float = 0.3
     map_scans: str = "keyframes"
+    degenerate_eigen_ratio: float = 0.05
+    degenerate_variance: float = 0.01
 
     def __post_init__(self) -> None:
         for f in dataclasses.fields(self):
@@ -209,6 +219,7 @@ class GraphParams:
             "loop_match_maximum_variance_coarse",
             "coarse_search_angle_offset",
             "loop_closure_max_residual",
+            "degenerate_variance",
         )
         for name in non_negative:
             _check(getattr(self, name) >= 0.0, f"{name} must be >= 0, got {getattr(self, name)}")
@@ -228,6 +239,7 @@ class GraphParams:
             "minimum_distance_penalty",
         ):
             _check(0.0 <= getattr(self, name) <= 1.0, f"{name} must be in [0, 1]")
+        _check(0.0 <= self.degenerate_eigen_ratio < 1.0, "degenerate_eigen_ratio must be in [0, 1)")
         _check(
             self.coarse_search_angle_offset <= math.pi, "coarse_search_angle_offset must be <= pi"
         )

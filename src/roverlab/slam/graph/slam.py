@@ -58,10 +58,11 @@ from numpy.typing import ArrayLike, NDArray
 
 from roverlab.geometry import SE2
 from roverlab.maps.grid import CountGrid, scan_arrays
-from roverlab.slam.common import ScanLike
+from roverlab.slam.common import Runaway, RunawayWatch, ScanLike
 from roverlab.slam.data.pose_solver import optimize
 from roverlab.slam.data.posegraph import PoseGraph
 from roverlab.slam.data.trajectory import Trajectory
+from roverlab.slam.degeneracy import scan_constraint
 from roverlab.slam.graph.errors import GraphSlamInputError
 from roverlab.slam.graph.loops import _OPT_ITERATIONS, LoopClosing
 from roverlab.slam.graph.matcher import (
@@ -179,6 +180,7 @@ class GraphSLAM(LoopClosing):
         self._kf_odom = np.zeros((0, 3))
         self._kf_scan_index: list[int] = []
         self._kf_scans: list[_Scan] = []
+        self._kf_weak: list[FloatArray | None] = []  # a degenerate keyframe's weak direction
         self._kf_prev_rel = np.zeros((0, 3))  # pose of keyframe k in keyframe k-1 at creation
         self._e_from: list[int] = []
         self._e_to: list[int] = []
@@ -196,6 +198,8 @@ class GraphSLAM(LoopClosing):
         self.rejected_loop_closures = 0
         self.optimisations = 0
         self.rim_searches = 0
+        self.degenerate_scans = 0
+        self.runaway: Runaway | None = None
         self.last_response = 0.0
 
     @property
@@ -300,7 +304,7 @@ class GraphSLAM(LoopClosing):
             self._all_scans.append(scan)
         if self._last_pose is None or self._last_odom is None:
             pose = odom.copy()
-            self._add_keyframe(pose, odom, scan, None)
+            self._add_keyframe(pose, odom, scan, None, None)
             pose = self._kf_pose[-1].copy()
         else:
             pred = _compose(self._last_pose, _relative(self._last_odom, odom))
@@ -311,16 +315,23 @@ class GraphSLAM(LoopClosing):
                 or abs(d_odom[2]) >= p.minimum_travel_heading
             )
             result: MatchResult | None = None
+            weak: FloatArray | None = None
+            cov: FloatArray | None = None
             if p.use_scan_matching and pts.shape[0] >= 3 and self._grid is not None:
                 result = self._match_sequential(self._grid, pts, pred, penalise=True, cov=keyframe)
                 result = self._beyond_the_rim(self._grid, pts, pred, result, keyframe)
-                pose = result.pose
+                pose, cov = result.pose, result.covariance
                 self.last_response = result.response
+                if p.degenerate_eigen_ratio > 0.0:
+                    ratio, direction = scan_constraint(pts)
+                    if ratio < p.degenerate_eigen_ratio:
+                        weak = direction
+                        self.degenerate_scans += 1
+                        pose, cov = self._keep_odometry(weak, pose, pred, cov)
             else:
                 pose = pred
             if keyframe:
-                cov = result.covariance if result is not None else None
-                self._add_keyframe(pose, odom, scan, cov)
+                self._add_keyframe(pose, odom, scan, cov, weak)
                 pose = self._kf_pose[-1].copy()
         k = self.num_keyframes - 1
         self._scan_ref.append(k)
@@ -407,10 +418,16 @@ class GraphSLAM(LoopClosing):
 
     # ---------------------------------------------------------------- graph building
     def _add_keyframe(
-        self, pose: FloatArray, odom: FloatArray, scan: _Scan, cov: FloatArray | None
+        self,
+        pose: FloatArray,
+        odom: FloatArray,
+        scan: _Scan,
+        cov: FloatArray | None,
+        weak: FloatArray | None,
     ) -> None:
         p = self.params
         k = self.num_keyframes
+        self._kf_weak.append(weak)
         prev_rel = np.zeros(3) if k == 0 else _relative(self._kf_pose[k - 1], pose)
         self._kf_pose = np.vstack([self._kf_pose, pose[None, :]])
         self._kf_odom = np.vstack([self._kf_odom, odom[None, :]])
@@ -539,11 +556,25 @@ class GraphSLAM(LoopClosing):
         return GraphMap(data, res, grid.origin_xy)
 
     # ---------------------------------------------------------------- batch
-    def run_log(self, log: Iterable[ScanLike]) -> GraphRun:
+    def run_log(self, log: Iterable[ScanLike], *, max_extent_m: float = math.inf) -> GraphRun:
         """Process every scan of a laser log (a ``roverlab.slam.data.LaserLog``) in order, then
-        optimise the graph once more and return one final pose per scan and the map."""
+        optimise the graph once more and return one final pose per scan and the map.
+
+        Args:
+            log: the scans.
+            max_extent_m: a scan whose predicted pose (the latest estimate moved by the
+                odometry) lies farther than this from the first pose along x or y has run
+                away: the run stops before it, :attr:`runaway` says where, and the map and
+                poses hold the scans before it (default: never).
+        """
         stamps: list[str] = []
-        for rec in log:
+        self.runaway = None
+        watch = RunawayWatch(max_extent_m, "graph")
+        for k, rec in enumerate(log):
+            pred = self.map_to_odom() * rec.odom_pose
+            self.runaway = watch.check(k, float(rec.timestamp), pred.x, pred.y)
+            if self.runaway is not None:
+                break
             ranges = np.asarray(rec.ranges)
             angles = rec.angle_min + rec.angle_increment * np.arange(ranges.size)
             self.process(

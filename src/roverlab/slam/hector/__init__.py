@@ -9,7 +9,7 @@
   :func:`cost`: its bilinear map value / gradient and its objective, for inspection.
 """
 
-from roverlab.slam.hector.degeneracy import ScanConstraint, scan_constraint
+from roverlab.slam.degeneracy import ScanConstraint, scan_constraint
 from roverlab.slam.hector.errors import (
     HectorError,
     HectorInputError,

@@ -96,7 +96,7 @@ class HectorParams:
         degenerate_eigen_ratio: (roverlab, with odometry) a scan whose surface normals'
             information has ``lambda_min / lambda_max`` below this cannot fix the robot
             along the weak direction (a bare corridor): along it the odometry increment is
-            kept instead of the match (:mod:`roverlab.slam.hector.degeneracy`); 0 turns it
+            kept instead of the match (:mod:`roverlab.slam.degeneracy`); 0 turns it
             off (hector: the match is taken and stalls in corridors).
         max_linear_velocity: (roverlab, with odometry) a match that moves the estimate
             faster than this (m/s) since the previous scan is a jump the robot cannot make:

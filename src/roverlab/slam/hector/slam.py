@@ -29,9 +29,10 @@ from numpy.typing import ArrayLike, NDArray
 
 from roverlab.geometry import SE2, wrap_angle
 from roverlab.maps.grid import scan_arrays
-from roverlab.slam.common import ScanLike
+from roverlab.slam.common import Runaway, ScanLike
 from roverlab.slam.data.trajectory import Trajectory
-from roverlab.slam.hector.degeneracy import map_values, scan_constraint
+from roverlab.slam.degeneracy import odometry_along, scan_constraint
+from roverlab.slam.hector.degeneracy import map_values
 from roverlab.slam.hector.errors import HectorInputError, OutOfMapError
 from roverlab.slam.hector.grid import HectorMap, MultiResGrid
 from roverlab.slam.hector.matcher import match
@@ -76,38 +77,6 @@ class GuardCounts:
     degenerate: int = 0
     jumps: int = 0
     collapsed: int = 0
-
-
-class Runaway(NamedTuple):
-    """Why a batch run stopped early: the estimate left the largest plausible map.
-
-    Attributes:
-        scan: index of the first scan not processed.
-        stamp: its log time (s).
-        jump_stamp: log time (s) of the estimate's largest step between two scans before
-            it (NaN if unknown), where it most likely jumped.
-        jump_m: the size of that step (m).
-        message: the error that stopped the run.
-    """
-
-    scan: int
-    stamp: float
-    jump_stamp: float
-    jump_m: float
-    message: str
-
-    def warning(self) -> str:
-        """One line naming where the estimate jumped."""
-        where = (
-            f"it jumped by {self.jump_m:.2f} m at log time {self.jump_stamp:.3f} s; "
-            if math.isfinite(self.jump_stamp)
-            else ""
-        )
-        return (
-            f"warning: hector's estimate ran away ({self.message}); {where}mapping stopped "
-            f"at log time {self.stamp:.3f} s (scan {self.scan}): the map and trajectory "
-            f"hold the scans before it"
-        )
 
 
 class HectorSLAM:
@@ -327,11 +296,7 @@ class HectorSLAM:
             # only surfaces the map already holds fix the robot against the map
             ratio, weak = scan_constraint(pts, values > _OCCUPIED_ABOVE)
             if ratio < p.degenerate_eigen_ratio:
-                c, s = math.cos(pose[2]), math.sin(pose[2])
-                vx, vy = c * weak[0] - s * weak[1], s * weak[0] + c * weak[1]
-                along = (predicted[0] - pose[0]) * vx + (predicted[1] - pose[1]) * vy
-                pose[0] += along * vx
-                pose[1] += along * vy
+                pose = odometry_along(pose, predicted, weak)
                 self.guard_counts.degenerate += 1
                 values = map_values(prob, k, centre, pose, pts)
         if p.max_free_endpoints < 1.0 and pts.shape[0]:
