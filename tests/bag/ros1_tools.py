@@ -9,7 +9,6 @@ from __future__ import annotations
 import json
 import os
 import shutil
-import socket
 import subprocess
 import time
 from collections.abc import Iterator
@@ -17,6 +16,8 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+
+from tests.helpers.net import free_port
 
 SYSTEM_PYTHON = "/usr/bin/python3"
 ROSCORE = "/usr/bin/roscore"
@@ -147,12 +148,6 @@ def write_real_bags(folder: Path) -> dict[str, Path]:
 
 def read_with_rosbag(*paths: Path) -> dict[str, Any]:
     return dict(system_python(READ_BAGS, [str(p) for p in paths]))
-
-
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return int(s.getsockname()[1])
 
 
 def roscore(home: Path) -> Iterator[int]:

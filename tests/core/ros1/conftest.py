@@ -1,6 +1,7 @@
 """Fixtures for the ROS 1 wire tests: Debian's real ROS 1 beside roverlab's.
 
-Every process listens on loopback only, on ports 11541-11549, and is stopped at the end of
+Every process listens on loopback only, on a port free when its fixture starts (two test
+workers, or anything else on the machine, may hold a fixed one), and is stopped at the end of
 its module. Tests that need real ROS 1 skip with one line when /usr/bin/roscore is missing.
 """
 
@@ -17,6 +18,7 @@ import pytest
 
 from roverlab.core.transport.ros1.errors import MasterError
 from roverlab.core.transport.ros1.xmlrpc import call
+from tests.helpers.net import free_port
 
 SCRIPTS = Path(__file__).parent / "scripts"
 DATA = Path(__file__).parent / "data"
@@ -79,12 +81,13 @@ def start_ros(master_uri: str, *args: str) -> subprocess.Popen[str]:
 
 @pytest.fixture(scope="module")
 def real_master() -> Iterator[str]:
-    """Debian's real rosmaster (the master roscore starts) on 127.0.0.1:11541."""
+    """Debian's real rosmaster (the master roscore starts) on a free loopback port."""
     if not HAVE_ROS1:
         pytest.skip("Debian's ROS 1 (/usr/bin/roscore) is not installed")
-    uri = "http://127.0.0.1:11541/"
+    port = free_port()
+    uri = f"http://127.0.0.1:{port}/"
     proc = subprocess.Popen(
-        ["/usr/bin/rosmaster", "--core", "-p", "11541", "-w", "2"],
+        ["/usr/bin/rosmaster", "--core", "-p", str(port), "-w", "2"],
         env=ros_env(uri),
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
@@ -98,10 +101,11 @@ def real_master() -> Iterator[str]:
 
 @pytest.fixture(scope="module")
 def roverlab_master() -> Iterator[str]:
-    """``roverlab roscore -p 11542`` as its own process."""
-    uri = "http://127.0.0.1:11542/"
+    """``roverlab roscore -p PORT`` as its own process, on a free loopback port."""
+    port = free_port()
+    uri = f"http://127.0.0.1:{port}/"
     proc = subprocess.Popen(
-        [sys.executable, "-m", "roverlab.cli", "roscore", "-p", "11542"],
+        [sys.executable, "-m", "roverlab.cli", "roscore", "-p", str(port)],
         stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE,
     )

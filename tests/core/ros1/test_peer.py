@@ -15,6 +15,7 @@ import pytest
 from roverlab.core.transport.ros1.peer import Ros1Peer, TopicSpec
 from roverlab.core.transport.ros1.xmlrpc import call
 from tests.core.ros1.conftest import SCRIPTS, run_ros, start_ros, stop, wait_master
+from tests.helpers.net import free_port
 
 STRING = TopicSpec("std_msgs/String", "992ce8a1687cec8c8bd883ec73ca41d1", "string data\n")
 
@@ -87,14 +88,15 @@ def _roverlab_roscore(port: int) -> subprocess.Popen[bytes]:
 
 
 def test_peer_registers_again_with_a_master_that_restarted() -> None:
-    uri = "http://127.0.0.1:11543/"
-    master = _roverlab_roscore(11543)
+    port = free_port()
+    uri = f"http://127.0.0.1:{port}/"
+    master = _roverlab_roscore(port)
     peer = Ros1Peer(uri)
     try:
         peer.advertise("/rl_pub", "/kept", STRING)
         time.sleep(1.5)  # the peer learns the first master's pid
         stop(master)
-        master = _roverlab_roscore(11543)  # a new master: it knows nothing of /kept
+        master = _roverlab_roscore(port)  # a new master: it knows nothing of /kept
         end = time.monotonic() + 10
         pubs: list[Any] = []
         while time.monotonic() < end:

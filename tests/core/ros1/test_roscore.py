@@ -13,6 +13,7 @@ from typing import Any
 from roverlab.core.transport.ros1.master import Master
 from roverlab.core.transport.ros1.xmlrpc import XmlRpcServer, call
 from tests.core.ros1.conftest import SCRIPTS, needs_ros1, run_ros, start_ros, stop
+from tests.helpers.net import free_port
 
 
 @needs_ros1
@@ -42,21 +43,22 @@ def test_real_ros_tools_and_rospy_nodes_against_roverlab_roscore(roverlab_master
 
 
 def test_roscore_port_in_use_is_one_line_exit_2(roverlab_master: str) -> None:
+    port = roverlab_master.rstrip("/").rsplit(":", 1)[1]
     r = subprocess.run(
-        [sys.executable, "-m", "roverlab.cli", "master", "-p", "11542"],
+        [sys.executable, "-m", "roverlab.cli", "master", "-p", port],
         capture_output=True,
         text=True,
         timeout=30,
     )
     assert r.returncode == 2
     assert r.stderr.strip().splitlines() == [
-        "error: cannot listen on 127.0.0.1:11542: Address already in use "
+        f"error: cannot listen on 127.0.0.1:{port}: Address already in use "
         "(another roscore running? try -p PORT)"
     ]
 
 
 def test_master_api_and_param_updates_one_per_node() -> None:
-    master = Master(port=11543)
+    master = Master(port=free_port())
     master.start()
     node = XmlRpcServer("127.0.0.1", 0)
     updates: list[tuple[str, Any]] = []

@@ -23,6 +23,7 @@ from tests.core.ros1.conftest import (
     stop,
     wait_master,
 )
+from tests.helpers.net import free_port
 
 
 def test_roverlab_nodes_are_ros1_nodes(real_master: str) -> None:
@@ -177,7 +178,7 @@ def test_services_both_ways_with_rospy_and_rosservice(real_master: str) -> None:
 
 @needs_ros1
 def test_launch_starts_a_master_and_puts_its_parameters_there() -> None:
-    uri = "http://127.0.0.1:11544/"  # nothing listens here: the launch starts a master
+    uri = f"http://127.0.0.1:{free_port()}/"  # nothing listens here: the launch starts a master
     env = {**os.environ, "ROS_MASTER_URI": uri, "ROS_HOSTNAME": "127.0.0.1"}
     launch_file = str(DATA / "map_server.launch")
     launch = subprocess.Popen(
