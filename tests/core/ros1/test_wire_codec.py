@@ -107,6 +107,38 @@ def test_a_subscriber_that_stops_reading_never_stalls_the_publisher() -> None:
     assert done.wait(5.0) and link.closed
 
 
+def test_an_outbound_link_keeps_every_frame_whole_and_in_order() -> None:
+    # an idle link writes in the publisher's thread; a message the socket takes only
+    # part of is finished by the writer thread before anything queued after it
+    a, b = socket.socketpair()
+    a.settimeout(None)
+    a.setsockopt(socket.SOL_SOCKET, socket.SO_SNDBUF, 4096)
+    link = OutboundLink(a, callerid="/reader", queue_size=1000)
+    sent = [bytes([i % 251]) * (1 + 37 * i % 20000) for i in range(400)]
+    got: list[bytes] = []
+
+    def read() -> None:
+        for _ in sent:
+            got.append(read_frame(b))
+            if len(got) % 50 == 0:
+                time.sleep(0.01)  # the reader lags: partial writes and queueing
+
+    reader = threading.Thread(target=read)
+    reader.start()
+    for i, data in enumerate(sent):
+        link.send(data)
+        if i % 100 == 0:
+            time.sleep(0.05)  # idle again: the direct path
+    reader.join(10.0)
+    end = time.monotonic() + 5.0
+    while link.sent < len(sent) and time.monotonic() < end:  # the writer's count follows
+        time.sleep(0.01)
+    assert got == sent and link.dropped == 0 and link.sent == len(sent)
+    assert link.bytes_sent == sum(len(d) + 4 for d in sent)
+    link.close()
+    b.close()
+
+
 def test_names_resolve_like_rosgraph() -> None:
     assert namespace_of("/a/b/node") == "/a/b/"
     assert namespace_of("/node") == "/"

@@ -40,14 +40,17 @@ def read_exact(sock: socket.socket, size: int) -> bytes:
         PeerClosedError: the connection ended first.
     """
     if size <= _CHUNK:
-        buf = bytearray(size)
-        view = memoryview(buf)
-        got = 0
-        while got < size:
-            n = sock.recv_into(view[got:], size - got)
-            if n == 0:
-                raise PeerClosedError(f"connection closed after {got} of {size} bytes")
-            got += n
+        # one system call for the whole unit, no copy: MSG_WAITALL returns short only
+        # at the end of the stream (or on a signal, hence the loop)
+        data = sock.recv(size, socket.MSG_WAITALL)
+        if len(data) == size:
+            return data
+        buf = bytearray(data)
+        while len(buf) < size:
+            part = sock.recv(size - len(buf), socket.MSG_WAITALL)
+            if not part:
+                raise PeerClosedError(f"connection closed after {len(buf)} of {size} bytes")
+            buf += part
         return bytes(buf)
     out = bytearray()
     while len(out) < size:

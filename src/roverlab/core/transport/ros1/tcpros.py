@@ -123,6 +123,8 @@ class OutboundLink:
         self.bytes_sent = 0
         self.closed = False
         self._cond = threading.Condition()
+        self._writing = False  # the writer thread is in sendall (outside the lock)
+        self._rest = b""  # the unsent tail of a message the publisher began (framed)
         self._on_close = on_close
         threading.Thread(target=self._write, daemon=True, name="tcpros-out").start()
 
@@ -130,6 +132,28 @@ class OutboundLink:
         with self._cond:
             if self.closed:
                 return
+            if not self.queue and not self._writing and not self._rest:
+                # Idle link: write in the caller's thread without blocking (no thread
+                # hand-off on the way out); what the socket does not take now, the
+                # writer thread finishes, so a subscriber that stops reading never
+                # stalls the publisher.
+                framed = frame(data)
+                try:
+                    n = self.sock.send(framed, socket.MSG_DONTWAIT)
+                except BlockingIOError:
+                    n = 0
+                except OSError:
+                    n = 0  # the writer meets the error and closes the link
+                if n == len(framed):
+                    self.bytes_sent += n
+                    self.sent += 1
+                    return
+                if n:
+                    self._rest = framed[n:]
+                    self.bytes_sent += n
+                    self.sent += 1
+                    self._cond.notify()
+                    return
             if len(self.queue) == self.queue.maxlen:
                 self.dropped += 1
             self.queue.append(data)
@@ -139,19 +163,25 @@ class OutboundLink:
         sock = self.sock
         while True:
             with self._cond:
-                while not self.queue and not self.closed:
+                while not self.queue and not self._rest and not self.closed:
                     self._cond.wait()
                 if self.closed:
                     break
+                rest, self._rest = self._rest, b""
                 batch = list(self.queue)
                 self.queue.clear()
+                self._writing = True
             try:
                 # one system call for what queued meanwhile (a flood sends in bursts)
-                sock.sendall(frame(batch[0]) if len(batch) == 1 else b"".join(map(frame, batch)))
-                self.bytes_sent += sum(len(d) + 4 for d in batch)
+                parts = [rest, *map(frame, batch)] if rest else list(map(frame, batch))
+                sock.sendall(parts[0] if len(parts) == 1 else b"".join(parts))
+                self.bytes_sent += len(rest) + sum(len(d) + 4 for d in batch)
                 self.sent += len(batch)
             except OSError:
                 break
+            finally:
+                with self._cond:
+                    self._writing = False
         self.close()
 
     def close(self) -> None:
