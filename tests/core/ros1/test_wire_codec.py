@@ -13,7 +13,12 @@ import xmlrpc.client
 import pytest
 
 from roverlab.core.transport.ros1.errors import HeaderError, ProtocolError
-from roverlab.core.transport.ros1.framing import PeerClosedError, read_frame, read_header
+from roverlab.core.transport.ros1.framing import (
+    FrameReader,
+    PeerClosedError,
+    read_frame,
+    read_header,
+)
 from roverlab.core.transport.ros1.header import decode_header, encode_header
 from roverlab.core.transport.ros1.names import namespace_of, resolve_name
 from roverlab.core.transport.ros1.params import ParamTree, compute_updates
@@ -137,6 +142,34 @@ def test_an_outbound_link_keeps_every_frame_whole_and_in_order() -> None:
     assert link.bytes_sent == sum(len(d) + 4 for d in sent)
     link.close()
     b.close()
+
+
+def test_a_frame_reader_splits_a_stream_at_any_boundary() -> None:
+    units = [b"", b"a" * 5, b"b" * 70000, b"c" * 3, b"d" * 5800, b"e" * 200000]
+    stream = b"".join(struct.pack("<I", len(u)) + u for u in units)
+    a, b = socket.socketpair()
+
+    def write() -> None:
+        for i in range(0, len(stream), 9973):  # chunks that cut lengths and bodies
+            a.sendall(stream[i : i + 9973])
+            time.sleep(0.001)
+        a.sendall(struct.pack("<I", 10) + b"xy")
+        a.close()
+
+    writer = threading.Thread(target=write)
+    writer.start()
+    reader = FrameReader(b)
+    assert [reader.read() for _ in units] == units
+    with pytest.raises(PeerClosedError, match="inside a unit"):
+        reader.read()
+    writer.join(5.0)
+    b.close()
+    c, d = socket.socketpair()
+    c.sendall(struct.pack("<I", 1 << 30))
+    with pytest.raises(ProtocolError, match="cap"):
+        FrameReader(d, max_bytes=1 << 20).read()
+    c.close()
+    d.close()
 
 
 def test_names_resolve_like_rosgraph() -> None:

@@ -18,7 +18,12 @@ from collections import deque
 from collections.abc import Callable
 
 from roverlab.core.transport.ros1.errors import HeaderError, ProtocolError
-from roverlab.core.transport.ros1.framing import frame, read_frame, read_header, write_header
+from roverlab.core.transport.ros1.framing import (
+    FrameReader,
+    frame,
+    read_header,
+    write_header,
+)
 
 __all__ = [
     "HANDSHAKE_TIMEOUT_S",
@@ -245,8 +250,9 @@ class InboundLink:
             self._check(peer)
             self.peer_header = peer
             sock.settimeout(None)
+            read = FrameReader(sock).read
             while not self.closed:
-                data = read_frame(sock)
+                data = read()
                 self.received += 1
                 self.bytes_received += len(data) + 4
                 self._deliver(data)
