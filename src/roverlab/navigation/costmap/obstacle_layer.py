@@ -16,10 +16,16 @@ sensor origin, filtered to ``[min_obstacle_height, max_obstacle_height]``. At ev
 The layer's costs go to the master by ``combination_method`` (0 overwrite, 1 maximum, any
 other value: not at all). ``observation_persistence`` keeps observations that long (0: only
 the latest); ``expected_update_rate`` makes the layer not current when a source is late.
+
+An observation may be buffered as a function that makes its points: it is called only
+when an update uses the observation, so a 50 Hz laser read by a 5 Hz costmap with
+``observation_persistence`` 0 is projected 5 times a second, not 50 (the points are the
+same as if projected on arrival; ROS projects every scan as it comes).
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -162,33 +168,55 @@ def project_scan(
     return np.column_stack([r * np.cos(a), r * np.sin(a), np.zeros_like(r)])
 
 
+#: Points of an observation, or a function making them (called once, when first used).
+PointSource = ArrayLike | Callable[[], ArrayLike]
+
+
+@dataclass(frozen=True, slots=True)
+class _Pending:
+    """An observation whose points are not made yet (see the module docstring)."""
+
+    origin: NDArray[np.float64]
+    make: Callable[[], ArrayLike]
+    stamp_s: float
+
+
 class ObservationBuffer:
     """costmap_2d's ``ObservationBuffer`` for one source."""
 
     def __init__(self, params: ObservationSourceParams) -> None:
         self.params = params
-        self.observations: list[Observation] = []
+        self.observations: list[Observation | _Pending] = []
         self.last_updated_s: float | None = None
 
     def buffer_points(
-        self, origin: ArrayLike, points: ArrayLike, stamp_s: float, now_s: float
+        self, origin: ArrayLike, points: PointSource, stamp_s: float, now_s: float
     ) -> None:
         """Add a cloud (global frame) seen from ``origin`` at ``stamp_s``; ``now_s`` is the
-        clock time (for ``expected_update_rate``)."""
+        clock time (for ``expected_update_rate``). ``points`` may be a function returning
+        the cloud: it is called when an update first uses the observation (never, when a
+        newer one replaces it first)."""
         o = np.asarray(origin, dtype=np.float64).reshape(3)
-        pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
         if not np.isfinite(o).all():
             raise CostmapError(f"observation {self.params.name}: sensor origin is not finite")
+        if callable(points):
+            obs: Observation | _Pending = _Pending(o, points, float(stamp_s))
+        else:
+            obs = self._observation(o, points, float(stamp_s))
+        self.observations.insert(0, obs)
+        self.last_updated_s = float(now_s)
+        self._purge()
+
+    def _observation(
+        self, origin: NDArray[np.float64], points: ArrayLike, stamp_s: float
+    ) -> Observation:
+        pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
         p = self.params
         z = pts[:, 2]
         with np.errstate(invalid="ignore"):
             keep = (z <= p.max_obstacle_height) & (z >= p.min_obstacle_height)
         keep &= np.isfinite(pts).all(axis=1)
-        self.observations.insert(
-            0, Observation(o, pts[keep], p.obstacle_range, p.raytrace_range, float(stamp_s))
-        )
-        self.last_updated_s = float(now_s)
-        self._purge()
+        return Observation(origin, pts[keep], p.obstacle_range, p.raytrace_range, stamp_s)
 
     def _purge(self) -> None:
         if not self.observations:
@@ -201,9 +229,21 @@ class ObservationBuffer:
         self.observations = [o for o in self.observations if latest - o.stamp_s <= keep]
 
     def get_observations(self) -> list[Observation]:
-        """The observations kept (newest first)."""
+        """The observations kept (newest first); points still to be made are made now.
+
+        Raises:
+            CostmapError: an observation whose points could not be made (it is dropped).
+        """
         self._purge()
-        return list(self.observations)
+        obs = self.observations
+        for i, o in enumerate(obs):
+            if isinstance(o, _Pending):
+                try:
+                    obs[i] = self._observation(o.origin, o.make(), o.stamp_s)
+                except (CostmapError, ValueError) as err:
+                    del obs[i]
+                    raise CostmapError(f"{self.params.name} dropped: {err}") from err
+        return list(obs)  # type: ignore[arg-type]  # every entry made above
 
     def is_current(self, now_s: float) -> bool:
         """Updated within ``expected_update_rate`` (always, when it is 0)."""
@@ -256,9 +296,10 @@ class ObstacleLayer(CostmapLayer):
         )
 
     def add_observation(
-        self, source: str, origin: ArrayLike, points: ArrayLike, stamp_s: float, now_s: float
+        self, source: str, origin: ArrayLike, points: PointSource, stamp_s: float, now_s: float
     ) -> None:
-        """Buffer a cloud of source ``source`` (global frame, seen from ``origin``)."""
+        """Buffer a cloud of source ``source`` (global frame, seen from ``origin``; or a
+        function making it, see :meth:`ObservationBuffer.buffer_points`)."""
         try:
             buf = self.buffers[source]
         except KeyError:
@@ -275,11 +316,11 @@ class ObstacleLayer(CostmapLayer):
         self.use_extra_bounds(bounds)
         for buf in self.buffers.values():
             if buf.params.clearing:
-                for obs in buf.get_observations():
+                for obs in self._observations(buf):
                     self._raytrace_freespace(obs, bounds)
         for buf in self.buffers.values():
             if buf.params.marking:
-                for obs in buf.get_observations():
+                for obs in self._observations(buf):
                     self._mark(obs, bounds)
         if self.params.footprint_clearing_enabled and len(self.layered.footprint) >= 3:
             self._footprint = transform_footprint(
@@ -287,6 +328,15 @@ class ObstacleLayer(CostmapLayer):
             )
             for x, y in self._footprint:
                 bounds.touch(float(x), float(y))
+
+    def _observations(self, buf: ObservationBuffer) -> list[Observation]:
+        """The buffer's observations; one whose points cannot be made is dropped (told in
+        ``sensor_warnings``), as the node drops a message it cannot convert."""
+        while True:
+            try:
+                return buf.get_observations()
+            except CostmapError as err:
+                self.sensor_warnings.append(str(err))
 
     def _mark(self, obs: Observation, bounds: Bounds) -> None:
         pts = obs.points
