@@ -19,18 +19,20 @@ host's ``NAME/`` (both ROS spellings, see :mod:`.params`; ``footprint`` and
 
 from __future__ import annotations
 
+import functools
 from typing import Any
 
 import numpy as np
 
 from roverlab.core import Context, Node, QoSProfile, Time
 from roverlab.geometry import SE2, Transform3
-from roverlab.msgs import OccupancyGrid, PolygonStamped, get_type, pointcloud2_to_xyz, scan_angles
+from roverlab.msgs import OccupancyGrid, PolygonStamped, get_type, pointcloud2_to_xyz
 from roverlab.msgs import classes as mc
 from roverlab.navigation.costmap.costmap_2d import Costmap2D
 from roverlab.navigation.costmap.footprint import transform_footprint
+from roverlab.navigation.costmap.kernels import scan_points
 from roverlab.navigation.costmap.layered import LayeredCostmap
-from roverlab.navigation.costmap.obstacle_layer import ObstacleLayer, project_scan
+from roverlab.navigation.costmap.obstacle_layer import ObstacleLayer
 from roverlab.navigation.costmap.params import CostmapParams, make_layered_costmap
 from roverlab.navigation.costmap.publisher import CostmapPublisherState, footprint_message
 from roverlab.navigation.costmap.static_layer import StaticLayer
@@ -177,14 +179,19 @@ class Costmap2DROS:
 
         def points() -> np.ndarray:  # made when an update first uses the observation
             if data_type == "LaserScan":
-                pts = project_scan(
-                    np.asarray(msg.ranges, dtype=np.float64),
-                    scan_angles(msg),
-                    float(msg.range_min),
-                    float(msg.range_max),
-                    inf_is_valid=inf_is_valid,
+                ranges = np.asarray(msg.ranges)
+                if ranges.dtype != np.float32 and ranges.dtype != np.float64:
+                    ranges = ranges.astype(np.float64)
+                cos_a, sin_a = _beam_trig(
+                    float(msg.angle_min), float(msg.angle_increment), len(ranges)
                 )
-            elif data_type == "PointCloud2":
+                # project_scan then g_T_msg.apply, in one compiled pass (the same values)
+                return scan_points(
+                    ranges, cos_a, sin_a, float(msg.range_min), float(msg.range_max),
+                    inf_is_valid, np.asarray(g_T_msg.rotation, dtype=np.float64),
+                    np.asarray(g_T_msg.translation, dtype=np.float64),
+                )  # fmt: skip
+            if data_type == "PointCloud2":
                 pts = pointcloud2_to_xyz(msg, skip_nans=True).astype(np.float64)
             else:
                 pts = np.array([[p.x, p.y, p.z] for p in msg.points], dtype=np.float64)
@@ -334,6 +341,16 @@ class Costmap2DROS:
     def start(self) -> None:
         """Resume updating."""
         self._stopped = False
+
+
+@functools.lru_cache(maxsize=16)
+def _beam_trig(angle_min: float, increment: float, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """Cosine and sine of each beam's angle (``scan_angles``), computed once per scan
+    geometry (read-only)."""
+    angles = angle_min + np.arange(count, dtype=np.float64) * increment
+    cos_a, sin_a = np.cos(angles), np.sin(angles)
+    cos_a.flags.writeable = sin_a.flags.writeable = False
+    return cos_a, sin_a
 
 
 def _apply(tf: Transform3, pts: np.ndarray) -> np.ndarray:

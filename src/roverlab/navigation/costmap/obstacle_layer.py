@@ -38,7 +38,7 @@ from roverlab.navigation.costmap.costmap_2d import (
     Costmap2D,
 )
 from roverlab.navigation.costmap.footprint import transform_footprint
-from roverlab.navigation.costmap.kernels import clear_rays, mark_points
+from roverlab.navigation.costmap.kernels import mark_observation, raytrace_freespace
 from roverlab.navigation.costmap.layered import Bounds, CostmapLayer
 from roverlab.navigation.errors import CostmapError
 from roverlab.navigation.params import check
@@ -276,6 +276,7 @@ class ObstacleLayer(CostmapLayer):
         self.sensor_warnings: list[str] = []
         self._footprint = np.zeros((0, 2))
         self._trace_buf = np.empty(0, dtype=np.int64)
+        self._box = np.zeros(4)  # min x, min y, max x, max y of a kernel's cells
 
     def on_initialize(self) -> None:
         track = self.params.track_unknown_space
@@ -343,21 +344,13 @@ class ObstacleLayer(CostmapLayer):
         if len(pts) == 0:
             return
         g = self.grid
-        d2 = np.sum((pts - obs.origin) ** 2, axis=1)
-        keep = (pts[:, 2] <= self.params.max_obstacle_height) & (
-            d2 < obs.obstacle_range * obs.obstacle_range
-        )
-        keep &= (pts[:, 0] >= g.origin_x) & (pts[:, 1] >= g.origin_y)
-        p = pts[keep]
-        mx = ((p[:, 0] - g.origin_x) / g.resolution).astype(np.int64)
-        my = ((p[:, 1] - g.origin_y) / g.resolution).astype(np.int64)
-        inside = (mx < g.size_x) & (my < g.size_y)
-        if not inside.any():
-            return
-        mark_points(g.costs, np.column_stack([mx[inside], my[inside]]), LETHAL_OBSTACLE)
-        p = p[inside]
-        bounds.touch(float(p[:, 0].min()), float(p[:, 1].min()))
-        bounds.touch(float(p[:, 0].max()), float(p[:, 1].max()))
+        box = self._box
+        if mark_observation(
+            g.costs, pts, obs.origin, self.params.max_obstacle_height, obs.obstacle_range,
+            g.origin_x, g.origin_y, g.resolution, LETHAL_OBSTACLE, box,
+        ):  # fmt: skip
+            bounds.touch(float(box[0]), float(box[1]))
+            bounds.touch(float(box[2]), float(box[3]))
 
     def _raytrace_freespace(self, obs: Observation, bounds: Bounds) -> None:
         g = self.grid
@@ -369,53 +362,22 @@ class ObstacleLayer(CostmapLayer):
             )
             return
         bounds.touch(ox, oy)
-        pts = obs.points[:, :2]
+        pts = obs.points
         if len(pts) == 0:
             return
         x0, y0 = g.origin_x, g.origin_y
         x1 = x0 + g.size_x * g.resolution
         y1 = y0 + g.size_y * g.resolution
-        wx, wy = pts[:, 0].copy(), pts[:, 1].copy()
-        a, b = wx - ox, wy - oy
-        with np.errstate(divide="ignore", invalid="ignore"):
-            # clip each ray to the map, in costmap_2d's order
-            m = wx < x0
-            t = (x0 - ox) / a
-            wx, wy = np.where(m, x0, wx), np.where(m, oy + b * t, wy)
-            m = wy < y0
-            t = (y0 - oy) / b
-            wx, wy = np.where(m, ox + a * t, wx), np.where(m, y0, wy)
-            m = wx > x1
-            t = (x1 - ox) / a
-            wx, wy = np.where(m, x1 - 0.001, wx), np.where(m, oy + b * t, wy)
-            m = wy > y1
-            t = (y1 - oy) / b
-            wx, wy = np.where(m, ox + a * t, wx), np.where(m, y1 - 0.001, wy)
-        ok = np.isfinite(wx) & np.isfinite(wy) & (wx >= x0) & (wy >= y0) & (wx < x1) & (wy < y1)
-        wx, wy = wx[ok], wy[ok]
-        if len(wx) == 0:
-            return
         need = g.size_x + g.size_y + 4
         if self._trace_buf.shape[0] < need:
             self._trace_buf = np.empty(need, dtype=np.int64)
-        ends = np.column_stack([(wx - x0) / g.resolution, (wy - y0) / g.resolution])
-        clear_rays(
-            g.costs,
-            (ox - x0) / g.resolution,
-            (oy - y0) / g.resolution,
-            np.ascontiguousarray(ends),
-            obs.raytrace_range / g.resolution,
-            FREE_SPACE,
-            self._trace_buf,
-        )
-        # updateRaytraceBounds: each ray's end, cut at raytrace_range
-        dx, dy = wx - ox, wy - oy
-        full = np.hypot(dx, dy)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            scale = np.where(full > 0, np.minimum(1.0, obs.raytrace_range / full), 1.0)
-        ex, ey = ox + dx * scale, oy + dy * scale
-        bounds.touch(float(ex.min()), float(ey.min()))
-        bounds.touch(float(ex.max()), float(ey.max()))
+        box = self._box
+        if raytrace_freespace(
+            g.costs, pts, ox, oy, x0, y0, x1, y1, g.resolution, obs.raytrace_range,
+            FREE_SPACE, self._trace_buf, box,
+        ):  # fmt: skip
+            bounds.touch(float(box[0]), float(box[1]))
+            bounds.touch(float(box[2]), float(box[3]))
 
     def update_costs(self, master: Costmap2D, x0: int, y0: int, xn: int, yn: int) -> None:
         if self.params.footprint_clearing_enabled and len(self._footprint) >= 3:
