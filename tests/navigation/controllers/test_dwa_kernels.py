@@ -13,6 +13,8 @@ import pytest
 
 from roverlab.geometry import SE2
 from roverlab.navigation.controllers import DWAParams, DWAPlanner, Velocity2D
+from roverlab.navigation.controllers.dwa.kernels import first_known_stretch
+from roverlab.navigation.controllers.dwa.planner import _adjust_resolution
 from roverlab.navigation.costmap import Costmap2D
 from roverlab.navigation.costmap.kernels import bresenham, footprint_cost
 from roverlab.navigation.errors import NoValidControlError
@@ -208,3 +210,32 @@ def test_footprint_cost_is_the_cell_by_cell_outline_cost() -> None:
             assert got == want, (pose, len(fp), scale)
             seen.add(got)
     assert {-6.0, 0.0, 50.0, 200.0} <= seen
+
+
+def _reference_stretch(plan: np.ndarray, cm: Costmap2D) -> np.ndarray:
+    """The numpy version: the plan adjusted to the resolution, each point looked up."""
+    pts = _adjust_resolution(plan, cm.resolution)
+    cells = np.floor((pts - [cm.origin_x, cm.origin_y]) / cm.resolution).astype(np.int64)
+    ok = (pts[:, 0] >= cm.origin_x) & (pts[:, 1] >= cm.origin_y)
+    ok &= (cells[:, 0] < cm.size_x) & (cells[:, 1] < cm.size_y)
+    ok[ok] = cm.costs[cells[ok, 1], cells[ok, 0]] != 255
+    idx = np.flatnonzero(ok)
+    if len(idx) == 0:
+        return np.zeros((0, 2), dtype=np.int64)
+    stop = np.flatnonzero(~ok[idx[0] :])
+    return cells[idx[0] : idx[0] + (int(stop[0]) if len(stop) else len(ok))]
+
+
+def test_first_known_stretch_is_the_adjusted_plan_looked_up() -> None:
+    rng = np.random.default_rng(8)
+    cm = Costmap2D(size_x=50, size_y=40, resolution=0.05, origin_x=-0.3, origin_y=0.2)
+    cm.costs[rng.integers(0, 40, 300), rng.integers(0, 50, 300)] = 255
+    lengths = set()
+    for _ in range(200):
+        n = int(rng.integers(1, 30))
+        plan = np.cumsum(rng.normal(scale=0.12, size=(n, 3)), axis=0) + np.array([0.9, 1.1, 0.0])
+        got = first_known_stretch(np.ascontiguousarray(plan[:, :2]), cm.costs, 0.05, -0.3, 0.2)
+        want = _reference_stretch(plan, cm)
+        np.testing.assert_array_equal(got, want)
+        lengths.add(min(len(want), 2))
+    assert lengths == {0, 1, 2}  # none known, a single cell and longer stretches all met

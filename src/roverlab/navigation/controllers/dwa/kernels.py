@@ -31,7 +31,7 @@ from numpy.typing import NDArray
 
 from roverlab.navigation.costmap.kernels import cells_cost, footprint_cells
 
-__all__ = ["rollout", "score_rollouts", "target_distance"]
+__all__ = ["first_known_stretch", "rollout", "score_rollouts", "target_distance"]
 
 _jit = numba.njit(cache=True, nogil=True)
 
@@ -97,6 +97,52 @@ def target_distance(
         row = (y + 1) * pw + 1
         for x in range(w):
             out[y, x] = dist[row + x]
+
+
+@_jit
+def first_known_stretch(
+    plan: NDArray[np.float64],
+    costs: NDArray[np.uint8],
+    res: float,
+    ox: float,
+    oy: float,
+) -> NDArray[np.int64]:
+    """The cells ``(ix, iy)`` of ``plan`` (``(N, >= 2)``, its points first made no farther
+    apart than ``res`` as MapGrid's ``adjustPlanResolution``: ``a + j (b - a) / steps``)
+    from its first point on a known cell of the costmap ``costs`` (origin ``ox, oy``) up
+    to the point before the next one off the map or on unknown cost; ``(0, 2)`` when no
+    point is on a known cell."""
+    h, w = costs.shape
+    n = plan.shape[0]
+    total = 1
+    for i in range(n - 1):
+        d = math.hypot(plan[i + 1, 0] - plan[i, 0], plan[i + 1, 1] - plan[i, 1])
+        total += int(math.ceil(d / res)) if d > res else 1
+    out = np.empty((total, 2), dtype=np.int64)
+    m = 0
+    started = False
+    for i in range(n):
+        if i < n - 1:
+            ax, ay = plan[i, 0], plan[i, 1]
+            dx, dy = plan[i + 1, 0] - ax, plan[i + 1, 1] - ay
+            d = math.hypot(dx, dy)
+            steps = int(math.ceil(d / res)) if d > res else 1
+        else:
+            ax, ay, dx, dy, steps = plan[i, 0], plan[i, 1], 0.0, 0.0, 1
+        for j in range(steps):
+            px = ax + (j * dx) / steps
+            py = ay + (j * dy) / steps
+            cx = int(math.floor((px - ox) / res))
+            cy = int(math.floor((py - oy) / res))
+            ok = px >= ox and py >= oy and cx < w and cy < h and costs[cy, cx] != NO_INFO
+            if ok:
+                started = True
+                out[m, 0] = cx
+                out[m, 1] = cy
+                m += 1
+            elif started:
+                return out[:m]
+    return out[:m]
 
 
 @_jit
