@@ -234,7 +234,9 @@ class DWAPlanner:
         front[-1, 0] += p.forward_point_distance * math.cos(ang)
         front[-1, 1] += p.forward_point_distance * math.sin(ang)
         front_stretch = _first_known_stretch(front, cm)
-        if front_stretch is not None:
+        if front_stretch is not None and (front_stretch[-1] == stretch[-1]).all():
+            front_grid[:] = goal_grid  # the same seed (the plan leaves the map before its end)
+        elif front_stretch is not None:
             target_distance(cm.costs, np.ascontiguousarray(front_stretch[-1:]), front_grid)
         else:
             front_grid[:] = cm.size_x * cm.size_y + 1
