@@ -74,12 +74,15 @@ class Publisher:
         """Deliver ``msg`` to every subscription of the topic (and remote listeners).
 
         Messages are passed by reference: treat a published message as read-only.
-        Safe to call from any thread; off the executor thread it is queued in.
+        Safe to call from any thread; off the executor thread it runs in the caller's
+        thread while the executor is parked with nothing to do (the message leaves for
+        other processes without a thread hand-off; local callbacks still run on the
+        executor), else it is queued in.
         """
         ex = self._executor
         tid = ex._thread_id
         if tid is not None and tid != threading.get_ident():
-            ex.call_soon_threadsafe(lambda: self.publish(msg))
+            ex.run_now_or_soon(lambda: self.publish(msg), drain=False)
             return
         topic = self.topic
         topic.published += 1

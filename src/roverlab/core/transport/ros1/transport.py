@@ -228,9 +228,12 @@ class Ros1Transport:
             self.peer.unsubscribe(fq, topic.name)
 
     def _on_bytes(self, topic: Topic, data: bytes) -> None:
+        """A message from a link's thread: decoded and handed to the callbacks in that
+        thread when the executor is idle (as rospy runs a callback in its connection's
+        thread; still one callback at a time), else queued for the executor."""
         ctx = self._context
         if ctx is not None:
-            ctx.executor.call_soon_threadsafe(partial(self._deliver, topic, data))
+            ctx.executor.run_now_or_soon(partial(self._deliver, topic, data))
 
     def _deliver(self, topic: Topic, data: bytes) -> None:
         try:
@@ -308,7 +311,7 @@ class Ros1Transport:
             finally:
                 done.set()
 
-        ctx.executor.call_soon_threadsafe(serve)
+        ctx.executor.run_now_or_soon(serve)
         if not done.wait(CALL_TIMEOUT_S):
             return (
                 False,
