@@ -13,6 +13,7 @@ from __future__ import annotations
 import logging
 import os
 import threading
+from collections.abc import Callable
 from functools import partial
 from typing import TYPE_CHECKING, Any
 
@@ -109,13 +110,19 @@ def topic_spec(typename: str) -> TopicSpec:
 class Ros1Transport:
     """Mirrors a context's nodes and topics into the ROS 1 graph of ``master_uri``.
 
+    Args:
+        master_uri: the master's XML-RPC URI.
+        on_wait: None for a one-shot tool (an unreachable master is an error at once);
+            for a node, where it hears that the master is not up yet while the
+            transport waits for it, as a rospy node does.
+
     Raises:
-        MasterError: no master answers at ``master_uri``.
+        MasterError: no master answers at ``master_uri`` and ``on_wait`` is None.
     """
 
-    def __init__(self, master_uri: str) -> None:
+    def __init__(self, master_uri: str, *, on_wait: Callable[[str], None] | None = None) -> None:
         self.master_uri = master_uri
-        self.peer = Ros1Peer(master_uri)
+        self.peer = Ros1Peer(master_uri, on_wait=on_wait)
         self.params = ParamMirror(master_uri)
         self.peer.on_param = lambda node, key, value: self.params.update(
             self._context, node, key, value
