@@ -12,8 +12,8 @@ Under a real rosmaster (port 11560), with 720-beam LaserScans (5.8 kB in ROS 1 b
   row also shows the sender's own rate, so it can be seen which side set the pace. A
   side's throughput is the lower of its two figures. rospy -> rospy end to end is shown
   too (there rospy's serialising sender sets the pace);
-- round trip (ping -> echo -> pong), median and p99: rospy <-> rospy, and roverlab's pinger
-  against the same rospy echo.
+- round trip (ping -> echo -> pong), median and p99: rospy's pinger and roverlab's, each
+  against a rospy echo, in alternating blocks (the machine's load falls on both alike).
 Targets (issue 26): roverlab's throughput >= rospy's, round trip <= 1.2x rospy's.
 The rospy side is benchmarks/ros1_wire_rospy.py, run by /usr/bin/python3.
 """
@@ -212,48 +212,50 @@ def flood_roverlab_receives(ctx: Context, n: int, senders: int) -> dict[str, Any
     return _flood_result(len(times), seconds, sent)
 
 
-def rtt_rospy(pings: int) -> dict[str, float]:
-    echo = rospy("echo", "/ping_a", "/pong_a")
-    wait_ready(echo)
-    try:
-        out = read_json(rospy("ping", "/ping_a", "/pong_a", str(pings)))
-    finally:
-        echo.terminate()
-        echo.wait(10)
-    return rtt_stats(out["rtt_ms"])
-
-
-def rtt_roverlab(ctx: Context, pings: int) -> dict[str, float]:
-    echo = rospy("echo", "/ping_b", "/pong_b")
-    wait_ready(echo)
+def round_trips(ctx: Context, pings: int, blocks: int) -> tuple[list[float], list[float]]:
+    """Round trip times (ms) of rospy's pinger and of roverlab's, each against its own
+    rospy echo, in ``blocks`` alternating blocks (a load change on the shared machine
+    falls on both alike)."""
+    echo_a = rospy("echo", "/ping_a", "/pong_a")
+    echo_b = rospy("echo", "/ping_b", "/pong_b")
+    wait_ready(echo_a)
+    wait_ready(echo_b)
     node = ctx.create_node("bench_ping")
     got = threading.Event()
     node.create_subscription(LaserScan, "/pong_b", lambda _m: got.set(), 10)
     pub = node.create_publisher(LaserScan, "/ping_b", 10)
     msg = make_scan()
+    ours: list[float] = []
+    theirs: list[float] = []
     try:
         end = time.monotonic() + 30
         while not got.is_set() and time.monotonic() < end:  # both links up
             pub.publish(msg)
             got.wait(0.1)
-        rtts = []
-        for _ in range(pings):
-            got.clear()
-            t0 = time.perf_counter()
-            pub.publish(msg)
-            if got.wait(2.0):
-                rtts.append((time.perf_counter() - t0) * 1000.0)
+        share = max(1, pings // blocks)
+        for _ in range(blocks):
+            theirs += read_json(rospy("ping", "/ping_a", "/pong_a", str(share)))["rtt_ms"]
+            for _ in range(share):
+                got.clear()
+                t0 = time.perf_counter()
+                pub.publish(msg)
+                if got.wait(2.0):
+                    ours.append((time.perf_counter() - t0) * 1000.0)
     finally:
-        echo.terminate()
-        echo.wait(10)
+        for echo in (echo_a, echo_b):
+            echo.terminate()
+            echo.wait(10)
         node.destroy_node()
-    return rtt_stats(rtts)
+    return theirs, ours
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--scans", type=int, default=5000, help="scans per flood")
     parser.add_argument("--pings", type=int, default=500, help="round trips per pair")
+    parser.add_argument(
+        "--blocks", type=int, default=5, help="alternating blocks the round trips come in"
+    )
     parser.add_argument(
         "--raw-senders",
         type=int,
@@ -294,9 +296,10 @@ def main() -> None:
             "flood_roverlab_sends": flood_roverlab_sends(ctx, args.scans),
             "flood_rospy_receives": flood_rospy_receives(args.scans, args.raw_senders),
             "flood_roverlab_receives": flood_roverlab_receives(ctx, args.scans, args.raw_senders),
-            "rospy_rtt_ms": rtt_rospy(args.pings),
-            "roverlab_rtt_ms": rtt_roverlab(ctx, args.pings),
         }
+        theirs, ours = round_trips(ctx, args.pings, args.blocks)
+        res["rospy_rtt_ms"] = rtt_stats(theirs)
+        res["roverlab_rtt_ms"] = rtt_stats(ours)
     finally:
         if ctx is not None:
             ctx.shutdown()
