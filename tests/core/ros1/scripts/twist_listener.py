@@ -8,8 +8,6 @@ from geometry_msgs.msg import Twist
 
 rospy.init_node("twist_listener", anonymous=True)
 topic = sys.argv[1] if len(sys.argv) > 1 else "cmd_vel"
-rospy.Subscriber(
-    topic, Twist, lambda m: print(f"{m.linear.x:.2f} {m.angular.z:.2f}", flush=True)
-)
+rospy.Subscriber(topic, Twist, lambda m: print(f"{m.linear.x:.2f} {m.angular.z:.2f}", flush=True))
 print("ready", flush=True)
 rospy.spin()
