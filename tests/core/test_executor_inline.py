@@ -135,3 +135,27 @@ def test_sim_mode_never_runs_work_outside_its_thread() -> None:
     assert ran == []
     ex.spin()
     assert ran == [threading.get_ident()]
+
+
+def test_a_spin_until_a_condition_returns_when_inline_work_meets_it() -> None:
+    ctx = Context(clock="wall", publish_clock=False)
+    ctx.create_node("n")
+    seen: list[int] = []
+    done: list[float] = []
+
+    def spin() -> None:
+        ctx.spin_until_condition(lambda: bool(seen), timeout_sec=10.0)
+        done.append(time.monotonic())
+
+    thread = threading.Thread(target=spin)
+    thread.start()
+    try:
+        assert _parked(ctx.executor)
+        t0 = time.monotonic()
+        assert ctx.executor.run_now_or_soon(lambda: seen.append(1))
+        thread.join(5.0)
+        assert done and done[0] - t0 < 2.0  # not the 10 s timeout
+    finally:
+        ctx.executor.stop()
+        thread.join(5.0)
+        ctx.shutdown()

@@ -99,6 +99,7 @@ class Executor:
         self._sleeping = False
         self._inline = False  # another thread runs callbacks while the executor is parked
         self._wait_target = _INF  # the clock time the parked executor waits for
+        self._spin_checks = False  # the spin has a stop condition or an event budget
         self._stopped = False
         self._pace_origin: tuple[int, int] | None = None  # (sim ns, perf_counter ns)
         self.clock_received = mode is not ClockMode.EXTERNAL
@@ -185,6 +186,7 @@ class Executor:
                     self._inbox
                     or self._ready
                     or self._stopped
+                    or self._spin_checks  # the work may have met the spin's stop_when
                     or (heap and heap[0][0] < self._wait_target)
                     or (self.mode is ClockMode.EXTERNAL and self.now_ns >= self._wait_target)
                 ):
@@ -352,6 +354,7 @@ class Executor:
         limit = _INF if until_ns is None else until_ns
         start_events = self.events_run
         sim = self.mode is ClockMode.SIM
+        self._spin_checks = stop_when is not None or max_events is not None
         try:
             if sim and stop_when is None and max_events is None:
                 self._spin_sim(limit)
