@@ -525,6 +525,10 @@ class Node:
         hint = f" (did you mean '{near[0]}'?)" if near else ""
         return f"node '{self._name}' has no parameter '{name}'{hint}"
 
+    def has_parameter_override(self, name: str) -> bool:
+        """Whether a launch file, YAML or ``_name:=value`` gave parameter ``name``."""
+        return name in self._overrides
+
     def unused_parameter_overrides(self) -> list[str]:
         """Overrides (from a launch file or YAML) that name no declared parameter."""
         return [name for name in self._overrides if name not in self._parameters]
