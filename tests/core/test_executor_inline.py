@@ -7,7 +7,7 @@ import threading
 import time
 from collections.abc import Callable
 
-from roverlab.core import Context
+from roverlab.core import Context, QoSProfile
 from roverlab.core.executor import ClockMode, Executor
 from roverlab.msgs import String
 
@@ -158,4 +158,21 @@ def test_a_spin_until_a_condition_returns_when_inline_work_meets_it() -> None:
     finally:
         ctx.executor.stop()
         thread.join(5.0)
+        ctx.shutdown()
+
+
+def test_a_late_subscription_from_another_thread_gets_the_latched_message() -> None:
+    ctx = Context(clock="wall", publish_clock=False)
+    node = ctx.create_node("n")
+    pub = node.create_publisher(
+        String, "/latched", QoSProfile(depth=1, durability="transient_local")
+    )
+    ctx.spin_in_thread()
+    try:
+        assert _parked(ctx.executor)
+        pub.publish(String(data="kept"))  # from this thread, while the executor is idle
+        got: list[str] = []
+        node.create_subscription(String, "/latched", lambda m: got.append(m.data), 1)
+        assert _wait(lambda: got == ["kept"])  # the executor was woken for it (or ran here)
+    finally:
         ctx.shutdown()

@@ -356,8 +356,14 @@ class Node:
         # Latched (transient-local) history reaches every late subscriber, as ROS 1's
         # latched topics do (ROS 2 also wants the subscriber transient-local; being
         # lenient here saves the usual "why is /map empty" question).
-        for msg in t.latched_history():
-            sub._enqueue(msg)
+        history = t.latched_history()
+        if history:
+            ex = self.context.executor
+            if ex.on_executor_thread():
+                for msg in history:
+                    sub._enqueue(msg)
+            else:  # another thread: hand it in, so the executor wakes for it
+                ex.run_now_or_soon(lambda: [sub._enqueue(msg) for msg in history])
         self.context._on_subscription(sub)
         if t.listener_watchers:
             t.notify_listeners()
