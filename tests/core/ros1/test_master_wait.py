@@ -14,7 +14,7 @@ import pytest
 from roverlab.core.transport.ros1.errors import MasterError
 from roverlab.core.transport.ros1.master import Master
 from roverlab.core.transport.ros1.xmlrpc import call, wait_for_master
-from tests.core.ros1.conftest import SCRIPTS, stop, wait_master
+from tests.core.ros1.conftest import SCRIPTS, stop
 from tests.helpers.net import free_port
 
 
@@ -79,12 +79,8 @@ def test_a_node_started_before_the_master_registers_once_it_comes() -> None:
         first = node.stderr.readline()
         assert f"unable to register with the ROS master at {uri}" in first, first
         assert node.poll() is None  # still waiting, not failed
-        master = subprocess.Popen(
-            [sys.executable, "-m", "roverlab.cli", "roscore", "-p", str(port)],
-            stdout=subprocess.DEVNULL,
-            stderr=subprocess.DEVNULL,
-        )
-        wait_master(uri)
+        master = Master(host="127.0.0.1", port=port)
+        master.start()
         end = time.monotonic() + 30
         pubs: list[list[str]] = []
         while time.monotonic() < end:
@@ -93,7 +89,8 @@ def test_a_node_started_before_the_master_registers_once_it_comes() -> None:
                 break
             time.sleep(0.2)
         assert any(topic == "/early" for topic, _ in pubs), pubs
+        assert node.stderr.readline().strip() == f"warning: reached the ROS master at {uri}"
     finally:
         stop(node)
         if master is not None:
-            stop(master)
+            master.stop()
