@@ -1,6 +1,7 @@
 """ROS 1 on the wire: roverlab against real rospy (Debian's ros_comm), on loopback.
 
-    python benchmarks/ros1_wire.py [--scans N] [--pings N] [--json FILE]
+    python benchmarks/ros1_wire.py [--scans N] [--pings N] [--blocks N] [--raw-senders N]
+                                   [--json FILE]
 
 Under a real rosmaster (port 11560), with 720-beam LaserScans (5.8 kB in ROS 1 bytes):
 - one way, as fast as possible (flood), received scans per second. A flood measures its
