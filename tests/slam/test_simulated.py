@@ -25,6 +25,7 @@ from roverlab.cli.slam_run import run_gmapping, run_graph, run_hector
 from roverlab.geometry import SE2
 from roverlab.slam.data import evaluate, load_log, read_relations, read_tum
 from roverlab.slam.data.scans import LaserLog, ScanRecord
+from roverlab.slam.data.straightness import corridor_stretches, straightness
 from roverlab.slam.data.trajectory import Trajectory
 from roverlab.slam.gmapping import GMapping, GMappingParams
 from roverlab.slam.hector import GuardCounts, HectorParams, HectorSLAM, scan_constraint
@@ -288,3 +289,25 @@ def test_a_match_that_jumps_or_collapses_is_not_taken() -> None:
             pure.process(r.ranges, r.angles(), r.odom_pose, range_max=r.range_max)
         pure.process(ranges, here.angles(), range_max=here.range_max)
         assert pure.guard_counts == GuardCounts()
+
+
+def test_the_straightness_check_measures_a_bend_in_a_simulated_building() -> None:
+    """A bent map is a failure the tests catch: in the ring corridor (four corridors at
+    right angles, found from the scans alone) the true trajectory scores 0 degrees, and the
+    same trajectory turned by 10 degrees about its middle pose (a map bent at a junction)
+    scores 10."""
+    sim = simulate(building("loop"), laser=LASERS["180"], noise=NOISE_LEVELS["none"],
+                   rng=np.random.default_rng(0), scan_rate_hz=1.0)  # fmt: skip
+    stretches = corridor_stretches(sim.log)
+    assert len(stretches) >= 4
+    truth = sim.truth.poses
+    assert straightness(sim.log, truth, stretches).bend_deg < 0.5
+    k = len(truth) // 2
+    turn = math.radians(10.0)
+    c, s = math.cos(turn), math.sin(turn)
+    bent = truth.copy()
+    d = truth[k:, :2] - truth[k, :2]
+    bent[k:, 0] = truth[k, 0] + c * d[:, 0] - s * d[:, 1]
+    bent[k:, 1] = truth[k, 1] + s * d[:, 0] + c * d[:, 1]
+    bent[k:, 2] += turn
+    assert straightness(sim.log, bent, stretches).bend_deg == pytest.approx(10.0, abs=0.5)

@@ -5,7 +5,7 @@ every particle's pose on its own map (:meth:`ScanMatching._match`, gmapping's
 ``ScanMatcher::optimize`` over the compiled kernels) and, when even the best particle
 matches poorly, searches widely around the odometry sample (:meth:`ScanMatching._recover`,
 see :mod:`roverlab.slam.gmapping.slam`). :class:`_Beams` is a scan as the matcher and the
-map update use it.
+map update use it (:func:`scan_beams`).
 """
 
 from __future__ import annotations
@@ -16,12 +16,13 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
+from roverlab.geometry import SE2
 from roverlab.slam.gmapping import kernels
 from roverlab.slam.gmapping.grid import ParticleMaps
 from roverlab.slam.gmapping.motion import compose, relative
 from roverlab.slam.gmapping.params import GMappingParams
 
-__all__ = ["ScanMatching"]
+__all__ = ["ScanMatching", "scan_beams"]
 
 # Odometry-failure recovery (see GMapping._recover): triggered when the best particle's
 # matcher score is below this fraction of the beams; searches +-(0.5 m + twice the odometry
@@ -49,6 +50,46 @@ class _Beams(NamedTuple):
     origin: NDArray[np.float64]  # (2,) laser position, robot frame
     ends: NDArray[np.float64]  # (M, 2) map-update end points (cropped), robot frame
     is_hit: NDArray[np.bool_]  # (M,) whether each map-update beam hit an obstacle
+
+
+def scan_beams(
+    r: NDArray[np.float64],
+    a: NDArray[np.float64],
+    range_min: float,
+    range_max: float,
+    off: SE2,
+    p: GMappingParams,
+) -> _Beams:
+    """A scan (ranges ``r``, beam angles ``a`` in the laser frame, laser pose ``off`` on the
+    robot) as gmapping's matcher and map update use it: readings below ``range_min`` count
+    as no return, beyond ``maxRange`` are dropped, are cropped to ``maxUrange`` for the
+    map, and every ``lskip + 1``-th beam that hit something within it is matched."""
+    r = r.copy()
+    r[r < range_min] = range_max
+    max_range = p.max_range(range_max)
+    usable = min(p.maxUrange, max_range)
+    with np.errstate(invalid="ignore"):
+        keep = np.isfinite(r) & (r > 0.0) & (r <= max_range)
+        hit = keep & (r < usable)
+    ang = a + off.theta
+    cos, sin = np.cos(ang), np.sin(ang)
+    origin = np.array([off.x, off.y])
+    d = np.minimum(r[keep], usable)
+    ends = np.stack([off.x + d * cos[keep], off.y + d * sin[keep]], axis=1)
+    step = p.lskip + 1
+    matched = hit & (np.arange(r.size) % step == step - 1)
+    rm = r[matched]
+    cm, sm = cos[matched], sin[matched]
+    hit_pts = np.stack([off.x + rm * cm, off.y + rm * sm], axis=1)
+    back = rm - p.delta
+    free_pts = np.stack([off.x + back * cm, off.y + back * sm], axis=1)
+    return _Beams(
+        hit=np.ascontiguousarray(hit_pts),
+        free=np.ascontiguousarray(free_pts),
+        origin=origin,
+        ends=np.ascontiguousarray(ends),
+        is_hit=np.ascontiguousarray(hit[keep]),
+    )
 
 
 class ScanMatching:

@@ -59,7 +59,7 @@ from roverlab.slam.degeneracy import odometry_along, scan_constraint
 from roverlab.slam.gmapping import kernels
 from roverlab.slam.gmapping.errors import GMappingInputError
 from roverlab.slam.gmapping.grid import GMappingMap, ParticleMaps
-from roverlab.slam.gmapping.matching import _RECOVER_BELOW, ScanMatching, _Beams
+from roverlab.slam.gmapping.matching import _RECOVER_BELOW, ScanMatching, _Beams, scan_beams
 from roverlab.slam.gmapping.motion import (
     compose,
     motion_sigmas,
@@ -330,7 +330,7 @@ class GMapping(ScanMatching):
         self._scans_seen += 1
         if self._scans_seen % self.params.throttle_scans != 0:
             return False
-        beams = self._beams(r, a, float(range_min), float(range_max), off)
+        beams = scan_beams(r, a, float(range_min), float(range_max), off, self.params)
         if not self._initialized:
             self._initialize(beams, odom, t)
             return True
@@ -418,42 +418,6 @@ class GMapping(ScanMatching):
         return GMappingRun(poses=poses, map=self.occupancy(), timestamps=np.array(stamps))
 
     # ------------------------------------------------------------------------ internals
-    def _beams(
-        self,
-        r: NDArray[np.float64],
-        a: NDArray[np.float64],
-        range_min: float,
-        range_max: float,
-        off: SE2,
-    ) -> _Beams:
-        p = self.params
-        r = r.copy()
-        r[r < range_min] = range_max
-        max_range = p.max_range(range_max)
-        usable = min(p.maxUrange, max_range)
-        with np.errstate(invalid="ignore"):
-            keep = np.isfinite(r) & (r > 0.0) & (r <= max_range)
-            hit = keep & (r < usable)
-        ang = a + off.theta
-        cos, sin = np.cos(ang), np.sin(ang)
-        origin = np.array([off.x, off.y])
-        d = np.minimum(r[keep], usable)
-        ends = np.stack([off.x + d * cos[keep], off.y + d * sin[keep]], axis=1)
-        step = p.lskip + 1
-        matched = hit & (np.arange(r.size) % step == step - 1)
-        rm = r[matched]
-        cm, sm = cos[matched], sin[matched]
-        hit_pts = np.stack([off.x + rm * cm, off.y + rm * sm], axis=1)
-        back = rm - p.delta
-        free_pts = np.stack([off.x + back * cm, off.y + back * sm], axis=1)
-        return _Beams(
-            hit=np.ascontiguousarray(hit_pts),
-            free=np.ascontiguousarray(free_pts),
-            origin=origin,
-            ends=np.ascontiguousarray(ends),
-            is_hit=np.ascontiguousarray(hit[keep]),
-        )
-
     def _initialize(self, beams: _Beams, odom: NDArray[np.float64], t: float) -> None:
         self._poses[:] = odom
         self._register(beams)

@@ -37,10 +37,9 @@ The trajectory (:meth:`GraphSLAM.scan_poses`) places it relative to the optimise
 the keyframes before and after it, blended by its position between them, so a correction
 of the graph is spread smoothly over the scans.
 
-The map (:meth:`GraphSLAM.occupancy`) is rendered from the optimised poses with the shared
-:class:`roverlab.maps.grid.CountGrid`, as Karto's ``OccupancyGrid``: hits over passes, cells
-passed by at most 2 beams unknown, occupied above a hit ratio of 0.1, beams beyond
-``max_laser_range`` clearing up to it.
+The map (:meth:`GraphSLAM.occupancy`) is rendered from the optimised poses as Karto's
+``OccupancyGrid`` renders it (:mod:`roverlab.slam.graph.outputs`, with the blending of the
+scans' poses).
 
 Poses are of the robot (base) frame in the map frame; the map frame starts on the odometry
 frame (the first scan's pose is its odometry pose), as in Karto.
@@ -50,14 +49,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass
 from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from roverlab.geometry import SE2
-from roverlab.maps.grid import CountGrid, scan_arrays
+from roverlab.maps.grid import scan_arrays
 from roverlab.slam.common import Runaway, RunawayWatch, ScanLike
 from roverlab.slam.data.pose_solver import optimize
 from roverlab.slam.data.posegraph import PoseGraph
@@ -75,6 +73,7 @@ from roverlab.slam.graph.matcher import (
     response,
     valid_points,
 )
+from roverlab.slam.graph.outputs import GraphMap, blend_scan_poses, render_map
 from roverlab.slam.graph.params import GraphParams
 from roverlab.slam.graph.poses import (
     _compose,
@@ -92,31 +91,8 @@ __all__ = ["GraphMap", "GraphRun", "GraphSLAM", "ScanLike", "run_graph", "run_lo
 
 FloatArray = NDArray[np.float64]
 
-#: Karto's ``OccupancyGrid`` defaults: minimum passes for a known cell, and hit ratio.
-MIN_PASS_THROUGH = 2
-OCCUPANCY_THRESHOLD = 0.1
 #: Most re-centred searches when a sequential match lands on the rim of its angular window.
 _RIM_SEARCHES = 3
-
-
-@dataclass(frozen=True, eq=False)
-class GraphMap:
-    """The occupancy map (``nav_msgs/OccupancyGrid`` conventions).
-
-    Attributes:
-        data: ``(H, W)`` int8, row 0 at the lowest y; -1 unknown, 0 free, 100 occupied.
-        resolution: cell size (m).
-        origin: world ``(x, y)`` of the outer corner of cell ``(0, 0)`` (m).
-    """
-
-    data: NDArray[np.int8]
-    resolution: float
-    origin: tuple[float, float]
-
-    @property
-    def origin_xy(self) -> tuple[float, float]:
-        """Alias of :attr:`origin` (the name :class:`roverlab.maps.grid` uses)."""
-        return self.origin
 
 
 class GraphRun(NamedTuple):
@@ -494,66 +470,16 @@ class GraphSLAM(LoopClosing):
         return self._kf_pose.copy()
 
     def scan_poses(self) -> FloatArray:
-        """``(N, 3)`` current pose of every processed scan.
-
-        A scan between keyframes ``r`` and ``r + 1`` is placed relative to both optimised
-        keyframes (through its relative pose to ``r`` and ``r + 1``'s relative pose to
-        ``r`` as matched) and the two placements are blended by the scan's position
-        between the keyframes.
-        """
-        n = len(self._scan_ref)
-        if n == 0:
-            return np.zeros((0, 3))
-        ref = np.asarray(self._scan_ref, dtype=np.intp)
-        rel = np.asarray(self._scan_rel, dtype=np.float64)
-        a = _compose(self._kf_pose[ref], rel)
-        k = self.num_keyframes
-        idx = np.asarray(self._kf_scan_index, dtype=np.intp)
-        has_next = ref + 1 < k
-        if np.any(has_next):
-            r = ref[has_next]
-            nxt = r + 1
-            b = _compose(
-                _compose(self._kf_pose[nxt], _inverse(self._kf_prev_rel[nxt])), rel[has_next]
-            )
-            s = np.flatnonzero(has_next)
-            w = (s - idx[r]) / np.maximum(idx[nxt] - idx[r], 1)
-            delta = _relative(a[has_next], b)
-            a[has_next] = _compose(a[has_next], delta * w[:, None])
-        return a
+        """``(N, 3)`` current pose of every processed scan (:func:`blend_scan_poses`)."""
+        return blend_scan_poses(
+            self._kf_pose, self._kf_prev_rel, self._kf_scan_index, self._scan_ref, self._scan_rel
+        )
 
     def occupancy(self) -> GraphMap:
-        """The map rendered from the current (optimised) poses with the shared
-        :class:`~roverlab.maps.grid.CountGrid` (Karto's ``OccupancyGrid`` rule)."""
-        p = self.params
-        if self.num_keyframes == 0:
-            return GraphMap(np.full((1, 1), -1, dtype=np.int8), p.resolution, (0.0, 0.0))
-        if p.map_scans == "all":
-            poses, scans = self.scan_poses(), self._all_scans
-        else:
-            poses, scans = self._kf_pose, self._kf_scans
-        lasers = _compose(poses, np.asarray([s.laser_offset for s in scans]))
-        x0, y0 = lasers[:, :2].min(axis=0) - 1.0
-        x1, y1 = lasers[:, :2].max(axis=0) + 1.0
-        res = p.resolution
-        ox = math.floor(x0 / res) * res
-        oy = math.floor(y0 / res) * res
-        grid = CountGrid(
-            max(1, math.ceil((x1 - ox) / res)), max(1, math.ceil((y1 - oy) / res)), res, (ox, oy)
-        )
-        for pose, scan in zip(lasers, scans, strict=True):
-            grid.update_scan(
-                pose,
-                scan.ranges,
-                scan.angles,
-                scan.range_max if math.isfinite(scan.range_max) else 1e9,
-                range_min=max(scan.range_min, p.min_laser_range),
-                usable_range=p.max_laser_range,
-                grow=True,
-            )
-        data = grid.to_occupancy(occupied_thresh=OCCUPANCY_THRESHOLD)
-        data[grid.visits <= MIN_PASS_THROUGH] = -1
-        return GraphMap(data, res, grid.origin_xy)
+        """The map rendered from the current (optimised) poses (:func:`render_map`)."""
+        if self.params.map_scans == "all":
+            return render_map(self.scan_poses(), self._all_scans, self.params)
+        return render_map(self._kf_pose, self._kf_scans, self.params)
 
     # ---------------------------------------------------------------- batch
     def run_log(self, log: Iterable[ScanLike], *, max_extent_m: float = math.inf) -> GraphRun:

@@ -105,6 +105,12 @@ class HectorParams:
         max_free_endpoints: (roverlab, with odometry) a match that puts more than this share
             of the endpoints on cells the map holds free has collapsed: the odometry
             prediction is kept and the map is not updated; 1 turns it off.
+        rival_match_threshold: (roverlab, with odometry) when the odometry's prediction
+            and the scan-only one (``motion_prediction``) differ by more than this (m, or
+            rad in heading), the scan is matched from both and the match that passes the
+            checks above and fits the map better (hector's cost ``sum (1 - M)^2``) is
+            taken: odometry that stalls and then catches up at once (mit-csail's, while
+            turning) would otherwise start the match tens of degrees off; 0 turns it off.
     """
 
     map_resolution: float = 0.025
@@ -133,6 +139,7 @@ class HectorParams:
     max_linear_velocity: float = 2.0
     max_angular_velocity: float = 4.0
     max_free_endpoints: float = 0.5
+    rival_match_threshold: float = 0.1
 
     def __post_init__(self) -> None:
         for f in dataclasses.fields(self):
@@ -190,6 +197,7 @@ class HectorParams:
         _check(self.max_linear_velocity >= 0.0, "max_linear_velocity must be >= 0")
         _check(self.max_angular_velocity >= 0.0, "max_angular_velocity must be >= 0")
         _check(0.0 < self.max_free_endpoints <= 1.0, "max_free_endpoints must be in (0, 1]")
+        _check(self.rival_match_threshold >= 0.0, "rival_match_threshold must be >= 0")
 
     @classmethod
     def from_ros(cls, params: Mapping[str, Any]) -> HectorParams:

@@ -72,11 +72,14 @@ class GuardCounts:
         degenerate: matches whose weak direction took the odometry increment.
         jumps: matches rejected for moving faster than the robot can.
         collapsed: matches rejected for putting the scan on free space.
+        rival: matches started from the scan-only prediction that fitted the map better
+            than the one started from the odometry's.
     """
 
     degenerate: int = 0
     jumps: int = 0
     collapsed: int = 0
+    rival: int = 0
 
 
 class HectorSLAM:
@@ -239,17 +242,21 @@ class HectorSLAM:
             pose = odom.copy()
         else:
             pose = self._pose.copy()
+            scan_only = pose
+            if p.motion_prediction == "constant_velocity" and self._last_motion is not None:
+                scan_only = _compose(pose, self._last_motion)
             guarded = p.use_odometry and odom is not None and self._last_odom is not None
             if guarded:
                 assert odom is not None and self._last_odom is not None
                 pose = _compose(pose, _relative(self._last_odom, odom))
-            elif p.motion_prediction == "constant_velocity" and self._last_motion is not None:
-                pose = _compose(pose, self._last_motion)
+            else:
+                pose = scan_only
             if pts.shape[0] and self.grid.updates:
                 predicted = pose
-                pose, self.last_hessian = self._match(pts, predicted)
                 if guarded:
-                    pose, accept = self._guard(pts, predicted, pose, stamp)
+                    pose, accept = self._guarded_match(pts, predicted, scan_only, stamp)
+                else:
+                    pose, self.last_hessian = self._match(pts, predicted)
         pose[2] = wrap_angle(float(pose[2]))
         if self.scans_processed:
             self._note_jump(pose, stamp)
@@ -274,21 +281,66 @@ class HectorSLAM:
             self._last_update_pose = pose.copy()
         return self.pose
 
+    def _guarded_match(
+        self,
+        pts: NDArray[np.float64],
+        predicted: NDArray[np.float64],
+        scan_only: NDArray[np.float64],
+        stamp: float | None,
+    ) -> tuple[NDArray[np.float64], bool]:
+        """Match from the odometry's prediction and, when the scan-only prediction differs
+        from it by more than ``rival_match_threshold``, from that one too; each match is
+        checked (:meth:`_guard`) and the one whose endpoints fit the map best (hector's
+        cost ``sum (1 - M)^2``) is taken. Returns the pose and whether the scan may update
+        the map: when no match passes, the odometry prediction, unmapped."""
+        p = self.params
+        dt = self._scan_period(stamp)
+        starts = [predicted]
+        gap = p.rival_match_threshold
+        if gap > 0.0 and (
+            math.hypot(scan_only[0] - predicted[0], scan_only[1] - predicted[1]) > gap
+            or abs(wrap_angle(float(scan_only[2] - predicted[2]))) > gap
+        ):
+            starts.append(scan_only)
+        best = None
+        verdicts = []
+        for i, start in enumerate(starts):
+            matched, hessian = self._match(pts, start)
+            pose, verdict, values, degenerate = self._guard(pts, predicted, matched, dt)
+            verdicts.append(verdict)
+            if verdict != "ok":
+                continue
+            cost = float(np.sum((1.0 - values) ** 2))
+            if best is None or cost < best[0]:
+                best = (cost, pose, hessian, i, degenerate)
+        if best is None:
+            if verdicts[0] == "jump":
+                self.guard_counts.jumps += 1
+            else:
+                self.guard_counts.collapsed += 1
+            return predicted.copy(), False
+        _, pose, self.last_hessian, i, degenerate = best
+        self.guard_counts.rival += int(i == 1)
+        self.guard_counts.degenerate += int(degenerate)
+        return pose, True
+
     def _guard(
         self,
         pts: NDArray[np.float64],
         predicted: NDArray[np.float64],
         matched: NDArray[np.float64],
-        stamp: float | None,
-    ) -> tuple[NDArray[np.float64], bool]:
-        """Check a match against the odometry prediction; return the pose and whether the
-        scan may update the map (see :class:`HectorParams`' odometry guards)."""
+        dt: float,
+    ) -> tuple[NDArray[np.float64], str, NDArray[np.float64], bool]:
+        """Check a match against the odometry prediction (see :class:`HectorParams`' odometry
+        guards); return the pose (along a degenerate direction: the odometry's), the
+        verdict (``"ok"``, ``"jump"``: faster than the robot can move, ``"collapsed"``: the
+        scan on free space), the map values under the endpoints at the pose and whether
+        the scan was degenerate."""
         p = self.params
-        dt = self._scan_period(stamp)
         if dt > 0.0 and _too_fast(self._pose, predicted, matched, dt, p):
-            self.guard_counts.jumps += 1
-            return predicted.copy(), False
+            return matched, "jump", np.zeros(0), False
         pose = matched.copy()
+        degenerate = False
         prob, k = self.grid.level_view(0), float(self.grid.inv_res[0])
         centre = (float(self.grid.centers[0, 0]), float(self.grid.centers[0, 1]))
         values = map_values(prob, k, centre, pose, pts)
@@ -297,14 +349,13 @@ class HectorSLAM:
             ratio, weak = scan_constraint(pts, values > _OCCUPIED_ABOVE)
             if ratio < p.degenerate_eigen_ratio:
                 pose = odometry_along(pose, predicted, weak)
-                self.guard_counts.degenerate += 1
+                degenerate = True
                 values = map_values(prob, k, centre, pose, pts)
         if p.max_free_endpoints < 1.0 and pts.shape[0]:
             share = float(np.count_nonzero(values < _FREE_BELOW)) / pts.shape[0]
             if share > p.max_free_endpoints:
-                self.guard_counts.collapsed += 1
-                return predicted.copy(), False
-        return pose, True
+                return pose, "collapsed", values, degenerate
+        return pose, "ok", values, degenerate
 
     def _scan_period(self, stamp: float | None) -> float:
         """The time since the previous scan, at least the usual scan period (a running
