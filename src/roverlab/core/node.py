@@ -363,7 +363,12 @@ class Node:
                 for msg in history:
                     sub._enqueue(msg)
             else:  # another thread: hand it in, so the executor wakes for it
-                ex.run_now_or_soon(lambda: [sub._enqueue(msg) for msg in history])
+
+                def enqueue_history() -> None:
+                    for msg in history:
+                        sub._enqueue(msg)
+
+                ex.run_now_or_soon(enqueue_history)
         self.context._on_subscription(sub)
         if t.listener_watchers:
             t.notify_listeners()
