@@ -26,7 +26,7 @@ footprint is refused where the robot stands but its body is clear, the samples a
 scored with the body's footprint and the cheapest whose last pose is clear with the
 padded one is taken; once backing up is blocked too, forward samples return. The body
 there is the ``footprint`` parameter with half the padding kept (it may leave out the
-wheels, as BARN's Jackal footprint does), or the bare one where that is refused already.
+wheels, as BARN's Jackal footprint does), or the bare one when that finds no way out.
 
 Failures raise :class:`NoValidControlError` (the robot must stop) or
 :class:`InvalidPathError`.
@@ -494,41 +494,38 @@ class DWAPlanner:
     ) -> tuple[int, NDArray[np.float64]]:  # fmt: skip
         """When the padded footprint is refused where the robot stands but its body is
         clear (an obstacle inside the padding): the samples scored with the body's
-        footprint (the first of :meth:`_escape_footprints` clear where the robot stands),
-        the cheapest one taken whose last pose is clear with the padded one."""
+        footprint, the cheapest one taken whose last pose is clear with the padded one;
+        with each of :meth:`_escape_footprints` in turn that is clear where the robot
+        stands, until one gives a sample."""
         fp = self.footprint
         p = self.params
         args = (cm.resolution, cm.origin_x, cm.origin_y)
         line = np.empty((cm.size_x + cm.size_y + 4, 2), dtype=np.int64)
+        acc = np.array([p.acc_lim_x, p.acc_lim_y, p.acc_lim_theta])
+        traj = np.empty((int(p.sim_time / min(p.sim_granularity, 1.0)) * 4 + 64, 3))
         for body in self._escape_footprints():
             if len(body) < 3 or (body.shape == fp.shape and np.array_equal(body, fp)):
                 return -1, costs
-            if footprint_cost(cm.costs, *args, pose.x, pose.y, pose.theta, body, 1.0, line) >= 0:
-                break
-        else:
-            return -1, costs
-        best, bcosts = self._score(pose, vel, samples, cm, self._only, prune=False, footprint=body)
-        if best < 0:
-            return -1, costs
-        acc = np.array([p.acc_lim_x, p.acc_lim_y, p.acc_lim_theta])
-        traj = np.empty((int(p.sim_time / min(p.sim_granularity, 1.0)) * 4 + 64, 3))
-        for k in np.argsort(np.where(bcosts >= 0, bcosts, np.inf), kind="stable"):
-            if bcosts[k] < 0:
-                break
-            num, _, _ = rollout(
-                pose.as_array(), vel.as_array(), samples[k], p.sim_time, p.sim_granularity,
-                p.angular_sim_granularity, not p.use_dwa, acc, 0.0, traj,
-            )  # fmt: skip
-            x, y, th = (float(v) for v in traj[max(num - 1, 0)])
-            if num and footprint_cost(cm.costs, *args, x, y, th, fp, 1.0, line) >= 0:
-                return int(k), bcosts
+            if footprint_cost(cm.costs, *args, pose.x, pose.y, pose.theta, body, 1.0, line) < 0:
+                continue
+            _, bcosts = self._score(pose, vel, samples, cm, self._only, prune=False, footprint=body)
+            for k in np.argsort(np.where(bcosts >= 0, bcosts, np.inf), kind="stable"):
+                if bcosts[k] < 0:
+                    break
+                num, _, _ = rollout(
+                    pose.as_array(), vel.as_array(), samples[k], p.sim_time, p.sim_granularity,
+                    p.angular_sim_granularity, not p.use_dwa, acc, 0.0, traj,
+                )  # fmt: skip
+                x, y, th = (float(v) for v in traj[max(num - 1, 0)])
+                if num and footprint_cost(cm.costs, *args, x, y, th, fp, 1.0, line) >= 0:
+                    return int(k), bcosts
         return -1, costs
 
     def _escape_footprints(self) -> list[NDArray[np.float64]]:
         """The body's footprints the ways out check, in order: the ``footprint``
         parameter with half the costmap's padding kept (padFootprint moves each vertex
         outwards, so the half-way polygon is the vertices' mean), then the bare
-        ``footprint`` for a robot already closer to an obstacle than that. The parameter
+        ``footprint`` when that one finds no way out. The parameter
         may leave out what the padding covers: BARN's Jackal footprint is its 0.33 m
         chassis, its wheels reach 0.42 m, and a robot turning past a pillar on the bare
         chassis touched it with a wheel."""
