@@ -1,7 +1,10 @@
 """The rospy side of benchmarks/ros1_wire.py (run by Debian's /usr/bin/python3, not the venv).
 
 ros1_wire_rospy.py flood TOPIC N     publish N 720-beam LaserScans as fast as rospy can
+                                     (each publish serialises the message, as rospy does)
 ros1_wire_rospy.py count TOPIC N     count LaserScans; print JSON {count, seconds}
+ros1_wire_rospy.py count_any TOPIC N count messages as rospy.AnyMsg (no decoding): a
+                                     receiver cheap enough that the sender sets the pace
 ros1_wire_rospy.py echo IN OUT       republish every LaserScan of IN on OUT
 ros1_wire_rospy.py ping OUT IN N     round trips OUT -> IN; print JSON {rtt_ms: [...]}
 """
@@ -39,12 +42,14 @@ def main():
     if mode == "flood":
         topic, n = sys.argv[2], int(sys.argv[3])
         pub = rospy.Publisher(topic, LaserScan, queue_size=n)
-        wait_connected(pub)
         msg = scan(0)
+        wait_connected(pub)
+        t0 = time.perf_counter()
         for _ in range(n):
             pub.publish(msg)
+        print(json.dumps({"sent": n, "seconds": time.perf_counter() - t0}), flush=True)
         time.sleep(2.0)
-    elif mode == "count":
+    elif mode in ("count", "count_any"):
         topic, n = sys.argv[2], int(sys.argv[3])
         times = []
         done = threading.Event()
@@ -54,7 +59,8 @@ def main():
             if len(times) >= n:
                 done.set()
 
-        rospy.Subscriber(topic, LaserScan, on_scan, queue_size=None)
+        kind = LaserScan if mode == "count" else rospy.AnyMsg
+        rospy.Subscriber(topic, kind, on_scan, queue_size=None)
         print("ready", flush=True)
         while not done.wait(0.2):
             if times and time.perf_counter() - times[-1] > 2.0:

@@ -84,8 +84,9 @@ def test_start_pose_rule(tmp_path: Path) -> None:
     [
         (["--initial", "1,2", "--global"], "error: --initial and --global exclude each other"),
         (["--initial", "1,two,3"], "error: --initial expects X,Y,YAW (m, m, rad), got '1,two,3'"),
-        (["--param", "laser_z_hti:=1"], "error: unknown amcl parameter 'laser_z_hti' (did you "
-                                         "mean 'laser_z_hit'?)"),
+        (["--param", "laser_z_hti:=1", "--initial", "1,two,3"],
+         "warning: amcl: unknown parameter 'laser_z_hti' (did you mean laser_z_hit?) is "
+         "ignored\nerror: --initial expects X,Y,YAW (m, m, rad), got '1,two,3'"),
         (["--initial", "30,0,0"], "error: initial pose (30.000, 0.000) is outside the map "
                                   "(x -1.00 .. 5.00, y -2.00 .. 2.00)"),
     ],

@@ -71,6 +71,16 @@ def test_transforms() -> None:
     _same(build.tf_message([got]), mc.TFMessage([ref]))
 
 
+def test_twist_and_pose_stamped() -> None:
+    _same(build.twist(1.0, 2.0, 3.0, 4.0, 5.0, 6.0),
+          mc.Twist(mc.Vector3(1.0, 2.0, 3.0), mc.Vector3(4.0, 5.0, 6.0)))  # fmt: skip
+    ref = mc.PoseStamped(
+        mc.Header(mc.Time(9, 10), "map"),
+        mc.Pose(mc.Point(1.0, 2.0, 0.0), mc.Quaternion(0.0, 0.0, 0.3, 0.9)),
+    )
+    _same(build.pose_stamped(9, 10, "map", 1.0, 2.0, 0.0, 0.0, 0.0, 0.3, 0.9), ref)
+
+
 def test_joint_state_and_laser_scan() -> None:
     pos, vel, eff = np.arange(2.0), np.arange(2.0) + 2, np.zeros(2)
     ref = mc.JointState(mc.Header(mc.Time(1, 2), ""), ["l", "r"], pos, vel, eff)

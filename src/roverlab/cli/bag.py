@@ -96,7 +96,9 @@ def record(
     path = _output_path(output)
     check_output(path, compression)  # one clear line before joining the network
     with stop_on_signals(threading.Event()) as stop:
-        conn = Connection(network_options(ctx), clock="external" if use_sim_time else "wall")
+        conn = Connection(
+            network_options(ctx), clock="external" if use_sim_time else "wall", node=True
+        )
         recorder = BagRecorder(
             path,
             compression=compression,
@@ -174,7 +176,10 @@ def play(
         remaps=parse_remaps(remap or []),
     )
     bag_info(bag)  # one clear error before joining the network
-    with stop_on_signals(threading.Event()) as stop, Connection(network_options(ctx)) as conn:
+    with (
+        stop_on_signals(threading.Event()) as stop,
+        Connection(network_options(ctx), node=True) as conn,
+    ):
         player = Player(conn.context, bag, options, warn=lambda line: typer.echo(line, err=True))
         conn.context.spin_in_thread()
         time.sleep(0.3)  # subscribers' declarations reach the new publishers

@@ -41,6 +41,7 @@ __all__ = [
     "connect_following_clock",
     "expose_if_asked",
     "is_loopback_endpoint",
+    "master_wait_note",
     "network_options",
     "run_context",
     "stop_on_signals",
@@ -150,17 +151,28 @@ def _sigterm_interrupts() -> Any:
     return signal.signal(signal.SIGTERM, interrupt)
 
 
-class Connection:
-    """A wall-clock context joined to the network, for one CLI command."""
+def master_wait_note(line: str) -> None:
+    """Where a command that runs as a ROS 1 node says it waits for the master."""
+    typer.echo(f"warning: {line}", err=True)
 
-    def __init__(self, options: NetworkOptions, *, clock: str = "wall") -> None:
+
+class Connection:
+    """A wall-clock context joined to the network, for one CLI command.
+
+    With ``ROS_MASTER_URI`` set and no master answering, a one-shot tool (``node``
+    False: topic, service, node, action, tf) fails at once, as rostopic does; a command
+    that runs as a node (teleop, dashboard, bag, map_saver) waits for the master, saying
+    so, as rospy and roscpp nodes do.
+    """
+
+    def __init__(self, options: NetworkOptions, *, clock: str = "wall", node: bool = False) -> None:
         self.context = Context(clock=clock, publish_clock=False)
         self.ros1: Ros1Transport | None = None
         self._old_sigterm: Any = None
         self._zenoh: ZenohTransport | None = None
         master = ros_master_uri()
         if master is not None:  # ROS_MASTER_URI: the command is a ROS 1 node
-            self.ros1 = Ros1Transport(master)
+            self.ros1 = Ros1Transport(master, on_wait=master_wait_note if node else None)
             self.context.add_transport(self.ros1)
             self._old_sigterm = _sigterm_interrupts()
             return
@@ -348,7 +360,7 @@ def expose_if_asked(
     if master is not None and choose_expose(expose, pace):
         # ROS_MASTER_URI (or --ros-master): the run is a ROS 1 participant instead of a
         # Zenoh one; a launch's own script processes still join it over Zenoh
-        context.add_transport(Ros1Transport(master))
+        context.add_transport(Ros1Transport(master, on_wait=master_wait_note))
         if also_listen:
             context.add_transport(ZenohTransport(ZenohOptions(listen=also_listen, connect=())))
     elif choose_expose(expose, pace):
@@ -398,7 +410,7 @@ def connect_following_clock(
         raise TransportError(f"unknown --clock {clock!r} ({', '.join(FOLLOWER_CLOCKS)})")
     master = ros_master_uri()
     if master is not None:
-        ros1 = Ros1Transport(master)
+        ros1 = Ros1Transport(master, on_wait=master_wait_note)
         if clock != "auto":
             return ros1, clock, ""
         if ros1.get_param("/use_sim_time", False) is True:

@@ -40,7 +40,10 @@ def foxglove(
     local = is_loopback(host)
     if local and token is not None:
         typer.echo("note: --token is only checked off loopback", err=True)
-    with stop_on_signals(threading.Event()) as stop, Connection(network_options(ctx)) as conn:
+    with (
+        stop_on_signals(threading.Event()) as stop,
+        Connection(network_options(ctx), node=True) as conn,
+    ):
         conn.context.spin_in_thread()
         bridge = FoxgloveBridge(
             conn.context, host if local else "127.0.0.1", port if local else 0,

@@ -103,7 +103,7 @@ def save(
     if timeout is not None and not (math.isfinite(timeout) and timeout > 0):
         raise MapError(f"--timeout must be a positive number of seconds, got {timeout}")
     name = resolve_name(topic)
-    with Connection(network_options(ctx)) as conn:
+    with Connection(network_options(ctx), node=True) as conn:
         saver = MapSaver(
             conn.context,
             path_prefix=file,

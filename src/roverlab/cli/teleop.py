@@ -181,7 +181,7 @@ def teleop(
         parameters[pname] = checked
     fd = stdin_fd()  # fail before touching the network when there is no keyboard
     code = 0
-    with Connection(network_options(ctx)) as conn:
+    with Connection(network_options(ctx), node=True) as conn:
         node = node_class(
             context=conn.context,
             node_name=parsed.node_name,

@@ -98,7 +98,7 @@ def _serve(
 ) -> None:
     choice = choose_port(port)
     check_port(host, choice)  # before the network: a taken port fails at once
-    with Connection(network_options(ctx)) as conn:
+    with Connection(network_options(ctx), node=True) as conn:
         server = DashboardServer(
             conn.context,
             host,

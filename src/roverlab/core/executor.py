@@ -25,6 +25,12 @@ Messages published at time *t* are delivered at time *t*, after every event that
 already queued for *t*: the sequence number breaks ties. Work handed in from other
 threads (the Zenoh transport, a user's main thread) goes through a locked inbox and is
 run at the executor's current time.
+
+In the real-time modes, work from another thread may instead run at once in that thread
+(:meth:`Executor.run_now_or_soon`) when the executor is parked with nothing queued or
+due: the executor stays parked until it is done, so callbacks still never run two at a
+time and keep their order, and a message from a socket reaches its callback without a
+thread wake-up (rospy runs a subscriber's callback in its connection's thread).
 """
 
 from __future__ import annotations
@@ -91,6 +97,9 @@ class Executor:
         self._cv = threading.Condition()
         self._thread_id: int | None = None
         self._sleeping = False
+        self._inline = False  # another thread runs callbacks while the executor is parked
+        self._wait_target = _INF  # the clock time the parked executor waits for
+        self._spin_checks = False  # the spin has a stop condition or an event budget
         self._stopped = False
         self._pace_origin: tuple[int, int] | None = None  # (sim ns, perf_counter ns)
         self.clock_received = mode is not ClockMode.EXTERNAL
@@ -131,6 +140,71 @@ class Executor:
         if self._sleeping:
             with self._cv:
                 self._cv.notify()
+
+    def run_now_or_soon(self, fn: Callable[[], Any], *, drain: bool = True) -> bool:
+        """Run ``fn`` now in the calling thread if the executor is parked (a real-time
+        mode waiting for its next event) with nothing queued or due; else hand it in as
+        :meth:`call_soon_threadsafe` does. True if it ran here.
+
+        While it runs here the calling thread stands for the executor's (time, thread
+        checks) and the executor stays parked, so callbacks never overlap. With ``drain``
+        the work ``fn`` queued for now (a delivery's callback) runs here too; else the
+        executor is woken for it.
+        """
+        cv = self._cv
+        with cv:
+            ok = (
+                self._sleeping
+                and not self._inline
+                and not self._stopped
+                and not self._inbox
+                and not self._ready
+            )
+            if ok and self._heap:
+                now = self.now_ns if self.mode is ClockMode.EXTERNAL else self._wall_now()
+                ok = self._heap[0][0] > now
+            if not ok:
+                self._inbox.append(fn)
+                if self._sleeping:
+                    cv.notify()
+                return False
+            self._inline = True
+            owner = self._thread_id
+            self._thread_id = threading.get_ident()
+        try:
+            if self.mode in (ClockMode.PACED, ClockMode.WALL):
+                self.now_ns = max(self.now_ns, self._wall_now())
+            self._run_one(fn)
+            if drain:
+                self._run_current()
+        finally:
+            with cv:
+                self._thread_id = owner
+                self._inline = False
+                heap = self._heap
+                if (
+                    self._inbox
+                    or self._ready
+                    or self._stopped
+                    or self._spin_checks  # the work may have met the spin's stop_when
+                    or (heap and heap[0][0] < self._wait_target)
+                    or (self.mode is ClockMode.EXTERNAL and self.now_ns >= self._wait_target)
+                ):
+                    cv.notify()
+        return True
+
+    def _run_current(self) -> None:
+        """Run what is queued for the current time (ready work, due timers) in order."""
+        heap = self._heap
+        ready = self._ready
+        while True:
+            due = bool(heap) and heap[0][0] <= self.now_ns
+            if ready and not (due and heap[0][1] < ready[0][0]):
+                self._run_one(ready.popleft()[1])
+            elif due:
+                self._run_one(heapq.heappop(heap)[2])
+            else:
+                return
 
     def on_executor_thread(self) -> bool:
         """True when called from the spinning thread, or when nothing is spinning."""
@@ -280,6 +354,7 @@ class Executor:
         limit = _INF if until_ns is None else until_ns
         start_events = self.events_run
         sim = self.mode is ClockMode.SIM
+        self._spin_checks = stop_when is not None or max_events is not None
         try:
             if sim and stop_when is None and max_events is None:
                 self._spin_sim(limit)
@@ -345,8 +420,11 @@ class Executor:
                     wait_s = remaining if wait_s is None else min(wait_s, remaining)
                 with self._cv:
                     self._sleeping = True
+                    self._wait_target = target
                     if not self._inbox and not self._stopped:
                         self._cv.wait(timeout=wait_s)
+                    while self._inline:  # another thread runs callbacks: stay parked
+                        self._cv.wait()
                     self._sleeping = False
                 if self.mode is not ClockMode.EXTERNAL and self.mode is not ClockMode.SIM:
                     self.now_ns = max(self.now_ns, min(self._wall_now(), target))

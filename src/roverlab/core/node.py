@@ -74,12 +74,15 @@ class Publisher:
         """Deliver ``msg`` to every subscription of the topic (and remote listeners).
 
         Messages are passed by reference: treat a published message as read-only.
-        Safe to call from any thread; off the executor thread it is queued in.
+        Safe to call from any thread; off the executor thread it runs in the caller's
+        thread while the executor is parked with nothing to do (the message leaves for
+        other processes without a thread hand-off; local callbacks still run on the
+        executor), else it is queued in.
         """
         ex = self._executor
         tid = ex._thread_id
         if tid is not None and tid != threading.get_ident():
-            ex.call_soon_threadsafe(lambda: self.publish(msg))
+            ex.run_now_or_soon(lambda: self.publish(msg), drain=False)
             return
         topic = self.topic
         topic.published += 1
@@ -353,8 +356,14 @@ class Node:
         # Latched (transient-local) history reaches every late subscriber, as ROS 1's
         # latched topics do (ROS 2 also wants the subscriber transient-local; being
         # lenient here saves the usual "why is /map empty" question).
-        for msg in t.latched_history():
-            sub._enqueue(msg)
+        history = t.latched_history()
+        if history:
+            ex = self.context.executor
+            if ex.on_executor_thread():
+                for msg in history:
+                    sub._enqueue(msg)
+            else:  # another thread: hand it in, so the executor wakes for it
+                ex.run_now_or_soon(lambda: [sub._enqueue(msg) for msg in history])
         self.context._on_subscription(sub)
         if t.listener_watchers:
             t.notify_listeners()
@@ -521,6 +530,10 @@ class Node:
         near = difflib.get_close_matches(name, list(self._parameters), n=1)
         hint = f" (did you mean '{near[0]}'?)" if near else ""
         return f"node '{self._name}' has no parameter '{name}'{hint}"
+
+    def has_parameter_override(self, name: str) -> bool:
+        """Whether a launch file, YAML or ``_name:=value`` gave parameter ``name``."""
+        return name in self._overrides
 
     def unused_parameter_overrides(self) -> list[str]:
         """Overrides (from a launch file or YAML) that name no declared parameter."""

@@ -4,17 +4,29 @@ A :class:`FieldKinds` says which fields of such a dataclass hold integers, boole
 or may be ``None`` (the rest are numbers). It converts a launch file's values the way the
 ROS parameter server hands them to the C++ node (an int for a double, an integral float for
 an int) and checks each field's type, naming the field in the error.
+
+:func:`unknown_warning` is the one line every tolerant parameter reader (amcl, move_base,
+the costmaps and planners) gives for a name nothing reads: ROS ignores such a parameter.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import difflib
 import math
-from collections.abc import Callable, Collection, Mapping
+from collections.abc import Callable, Collection, Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-__all__ = ["FieldKinds"]
+__all__ = ["FieldKinds", "unknown_warning"]
+
+
+def unknown_warning(where: str, key: str, known: Iterable[str]) -> str:
+    """The warning for a parameter nothing reads: its name, a "did you mean" hint, and
+    that it is ignored (ROS ignores parameters no plugin reads)."""
+    near = difflib.get_close_matches(key, list(known), n=1)
+    hint = f" (did you mean {near[0]}?)" if near else ""
+    return f"{where}: unknown parameter {key!r}{hint} is ignored"
 
 
 @dataclass(frozen=True, slots=True)
@@ -39,11 +51,12 @@ class FieldKinds:
         names: Collection[str],
         *,
         ignored: Collection[str],
-        unknown: Callable[[str], Exception],
+        unknown: Callable[[str], Exception | None],
     ) -> dict[str, Any]:
         """Keyword arguments for the dataclass from ROS-named ``params``.
 
-        Names in ``ignored`` are dropped; a name not in ``names`` raises ``unknown(name)``;
+        Names in ``ignored`` are dropped; for a name not in ``names``, ``unknown(name)`` is
+        raised, or the name dropped when it returns None (a reader that warns instead);
         an integral float becomes an int for an integer field and an int a float for a
         number field; booleans, strings and anything else pass as they are (the dataclass
         checks them with :meth:`check`).
@@ -53,7 +66,10 @@ class FieldKinds:
             if key in ignored:
                 continue
             if key not in names:
-                raise unknown(key)
+                err = unknown(key)
+                if err is not None:
+                    raise err
+                continue
             if isinstance(value, bool) or key in self.strs or key in self.bools:
                 kwargs[key] = value
             elif key in self.ints and isinstance(value, float) and value.is_integer():

@@ -19,7 +19,16 @@ from typing import Any
 
 from . import classes as mc
 
-__all__ = ["imu", "joint_state", "laser_scan", "odometry", "tf_message", "transform_stamped"]
+__all__ = [
+    "imu",
+    "joint_state",
+    "laser_scan",
+    "odometry",
+    "pose_stamped",
+    "tf_message",
+    "transform_stamped",
+    "twist",
+]
 
 # typed loosely: the objects get their fields (and ``__msgtype__``) assigned one by one
 _new: Callable[[type[Any]], Any] = object.__new__
@@ -29,6 +38,7 @@ _Vector3, _VECTOR3 = mc.Vector3, mc.Vector3.__msgtype__
 _Point, _POINT = mc.Point, mc.Point.__msgtype__
 _Quaternion, _QUATERNION = mc.Quaternion, mc.Quaternion.__msgtype__
 _Pose, _POSE = mc.Pose, mc.Pose.__msgtype__
+_PoseStamped, _POSE_STAMPED = mc.PoseStamped, mc.PoseStamped.__msgtype__
 _PoseCov, _POSE_COV = mc.PoseWithCovariance, mc.PoseWithCovariance.__msgtype__
 _Twist, _TWIST = mc.Twist, mc.Twist.__msgtype__
 _TwistCov, _TWIST_COV = mc.TwistWithCovariance, mc.TwistWithCovariance.__msgtype__
@@ -170,6 +180,69 @@ def odometry(
     m.pose = pc
     m.twist = tc
     m.__msgtype__ = _ODOMETRY
+    return m
+
+
+def twist(vx: float, vy: float, vz: float, wx: float, wy: float, wz: float) -> Any:
+    """``geometry_msgs/Twist``: linear and angular velocity (move_base's ``cmd_vel``)."""
+    lin = _new(_Vector3)
+    lin.x = vx
+    lin.y = vy
+    lin.z = vz
+    lin.__msgtype__ = _VECTOR3
+    ang = _new(_Vector3)
+    ang.x = wx
+    ang.y = wy
+    ang.z = wz
+    ang.__msgtype__ = _VECTOR3
+    m = _new(_Twist)
+    m.linear = lin
+    m.angular = ang
+    m.__msgtype__ = _TWIST
+    return m
+
+
+def pose_stamped(
+    sec: int,
+    nanosec: int,
+    frame_id: str,
+    x: float,
+    y: float,
+    z: float,
+    qx: float,
+    qy: float,
+    qz: float,
+    qw: float,
+) -> Any:
+    """``geometry_msgs/PoseStamped``: stamp, frame, position, orientation (move_base's
+    feedback)."""
+    t = _new(_Time)
+    t.sec = sec
+    t.nanosec = nanosec
+    t.__msgtype__ = _TIME
+    h = _new(_Header)
+    h.stamp = t
+    h.frame_id = frame_id
+    h.__msgtype__ = _HEADER
+    p = _new(_Point)
+    p.x = x
+    p.y = y
+    p.z = z
+    p.__msgtype__ = _POINT
+    q = _new(_Quaternion)
+    q.x = qx
+    q.y = qy
+    q.z = qz
+    q.w = qw
+    q.__msgtype__ = _QUATERNION
+    pose = _new(_Pose)
+    pose.position = p
+    pose.orientation = q
+    pose.__msgtype__ = _POSE
+    m = _new(_PoseStamped)
+    m.header = h
+    m.pose = pose
+    m.__msgtype__ = _POSE_STAMPED
     return m
 
 

@@ -13,11 +13,11 @@ are taken under their new name with a warning, as ``nav_core::warnRenamedParamet
 from __future__ import annotations
 
 import dataclasses
-import difflib
 import math
 from collections.abc import Iterable, Mapping
 from typing import Any, TypeVar
 
+from roverlab.core.rosparams import unknown_warning
 from roverlab.navigation.errors import NavigationParamsError
 
 __all__ = [
@@ -84,14 +84,6 @@ def _coerce(where: str, name: str, annotation: str, value: Any) -> Any:
             return value
         raise NavigationParamsError(f"{where}: {name} must be a string, got {value!r}")
     return value  # structured values are checked by the dataclass itself
-
-
-def unknown_warning(where: str, key: str, known: Iterable[str]) -> str:
-    """The warning for a parameter nothing reads: its name, a "did you mean" hint, and
-    that it is ignored (ROS ignores parameters no plugin reads)."""
-    near = difflib.get_close_matches(key, list(known), n=1)
-    hint = f" (did you mean {near[0]}?)" if near else ""
-    return f"{where}: unknown parameter {key!r}{hint} is ignored"
 
 
 @dataclasses.dataclass(frozen=True, slots=True)

@@ -21,7 +21,7 @@ from roverlab.geometry import Transform3, quat_from_rpy, quat_rotate, rpy_from_q
 from roverlab.msgs import builders as build
 from roverlab.msgs import classes as mc
 from roverlab.msgs import xyz_to_pointcloud2
-from roverlab.perception.image_transport.node import CompressedPublisher
+from roverlab.perception.image_transport.publisher import CompressedPublisher
 from roverlab.raycast import Scene
 from roverlab.raycast.camera import camera_intrinsics, depth_to_points
 from roverlab.sim.collision import Obstacles, inner_radius

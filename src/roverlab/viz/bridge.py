@@ -22,6 +22,7 @@ import re
 import threading
 import time
 from collections.abc import Callable, Sequence
+from functools import partial
 from pathlib import Path
 from typing import Any, Final
 
@@ -168,6 +169,7 @@ class VizBridge(DisplayStatus):
         self._slider_pub: Any = None
         self._description_sub: Any = None
         self._description_topic = ""
+        self._description_text = ""  # the robot description shown now
         self.config = config if config is not None else default_config(fixed_frame)
         self.config_version = 1
         self.displays: list[DisplayState] = []
@@ -300,6 +302,7 @@ class VizBridge(DisplayStatus):
             self.node.destroy_subscription(self._description_sub)
             self._description_sub = None
         self._description_topic = topic
+        self._description_text = ""
         self.outlines = None
         self.shapes = []
         if topic:
@@ -310,18 +313,29 @@ class VizBridge(DisplayStatus):
 
     def _description_from_master(self, name: str) -> None:
         """On a ROS 1 graph the robot description is the master's parameter of that name
-        (as rviz's RobotModel reads it), not a topic: read it once from there."""
+        (as rviz's RobotModel reads it), not a topic: read it from there, and again each
+        time it is set (the master's paramUpdate), where the transport can watch it."""
         for transport in self.node.context.transports:
+            watch = getattr(transport, "watch_param", None)
             get_param = getattr(transport, "get_param", None)
-            if get_param is None:
+            if watch is not None:
+                text = watch(self.node, name, partial(self._description_param, name))
+            elif get_param is not None:
+                text = get_param(name, None)
+            else:
                 continue
-            text = get_param(name, None)
-            if isinstance(text, str) and text.strip():
-                try:
-                    self._on_description(String(data=text))
-                except (RoverlabError, ValueError) as err:
-                    self.node.get_logger().warning(f"robot description {name}: {err}")
-                return
+            self._description_param(name, text)
+            return
+
+    def _description_param(self, name: str, text: Any) -> None:
+        if name != self._description_topic or not isinstance(text, str) or not text.strip():
+            return
+        if text == self._description_text:
+            return  # the same text again (our own topic mirrored to the parameter)
+        try:
+            self._on_description(String(data=text))
+        except (RoverlabError, ValueError) as err:
+            self.node.get_logger().warning(f"robot description {name}: {err}")
 
     def _subscribe(self, state: DisplayState, key: tuple[str, str]) -> Any:
         topic, typename = key
@@ -372,6 +386,7 @@ class VizBridge(DisplayStatus):
 
     def _on_description(self, msg: Any) -> None:
         model = parse_urdf(str(msg.data), source=self._description_topic)
+        self._description_text = str(msg.data)
         self.shapes = [shape.to_dict() for shape in robot_shapes(model)]
         self.outlines = Versioned(self.next_version(), robot_outlines(model))
         self.joint_sliders = JointSliders(model)

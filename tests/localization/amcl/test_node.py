@@ -397,3 +397,27 @@ def test_std_warn_levels_warn_about_a_wide_estimate(caplog: pytest.LogCaptureFix
     assert "x 0.200 > std_warn_level_x 0.1, yaw 0.200 > std_warn_level_yaw 0.1" in caplog.text
     assert "y 0.100" not in caplog.text
     ctx.shutdown()
+
+
+def test_a_launch_with_names_amcl_does_not_read_starts_and_warns_once_each(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    """ROS's amcl ignores parameters it does not read; roverlab's warns about each once,
+    by name, and an unknown laser model falls back to likelihood_field as amcl does."""
+    path = tmp_path / "odd.launch"
+    path.write_text('<launch><node pkg="amcl" type="amcl" name="amcl">'
+                    '<param name="laser_model_type" value="sonar"/>'
+                    '<param name="laser_z_hti" value="0.5"/>'
+                    '<param name="use_odom_twist" value="true"/></node></launch>')  # fmt: skip
+    with caplog.at_level(logging.WARNING, logger="roverlab"):
+        started = build_launch(path, context=Context())
+    (node,) = [n for n in started.nodes if isinstance(n, AmclNode)]
+    assert node.params.laser_model_type == "likelihood_field"
+    said = [r.message for r in caplog.records]
+    for line in (
+        "amcl: unknown parameter 'laser_z_hti' (did you mean laser_z_hit?) is ignored",
+        "amcl: unknown parameter 'use_odom_twist' is ignored",
+        'Unknown laser model type "sonar"; defaulting to likelihood_field model',
+    ):
+        assert sum(line in m for m in said) == 1, (line, said)
+    assert not any("laser_z_hti" in w for w in started.warnings)  # not a second time

@@ -62,10 +62,6 @@ def test_from_ros_coerces_numbers_and_drops_ignored_names() -> None:
 @pytest.mark.parametrize(
     ("params", "message"),
     [
-        (
-            {"laser_z_hti": 0.5},
-            "unknown amcl parameter 'laser_z_hti' (did you mean 'laser_z_hit'?)",
-        ),
         ({"min_particles": 600, "max_particles": 500}, "min_particles <= max_particles"),
         ({"odom_model_type": "ackermann"}, "odom_model_type must be one of"),
         ({"kld_err": 0.0}, "kld_err must be in (0, 1)"),
@@ -80,6 +76,24 @@ def test_bad_parameters_are_one_clear_error(params: dict[str, object], message: 
     with pytest.raises(AmclParamsError) as err:
         AmclParams.from_ros(params)
     assert message in str(err.value)
+
+
+def test_unknown_names_are_warned_about_by_name_and_ignored_as_ros_does() -> None:
+    warnings: list[str] = []
+    p = AmclParams.from_ros(
+        {"laser_z_hti": 0.5, "min_particles": 300, "tf_prefix": "", "use_odom_twist": True},
+        warnings=warnings,
+    )
+    assert p.min_particles == 300 and p.laser_z_hit == AmclParams().laser_z_hit
+    assert warnings == [
+        "amcl: unknown parameter 'laser_z_hti' (did you mean laser_z_hit?) is ignored",
+        "amcl: unknown parameter 'tf_prefix' is ignored",
+        "amcl: unknown parameter 'use_odom_twist' is ignored",
+    ]
+    assert AmclParams.from_ros({"bag_scan_period": 0.1}, warnings=warnings) == AmclParams()
+    assert len(warnings) == 3  # a name amcl reads but roverlab need not: quiet
+    with pytest.raises(AmclParamsError, match="min_particles must be >= 1"):
+        AmclParams.from_ros({"laser_z_hti": 0.5, "min_particles": 0})  # values still checked
 
 
 def test_an_unknown_laser_model_is_a_warning_and_likelihood_field_as_amcl_does() -> None:

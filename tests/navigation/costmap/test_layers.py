@@ -176,6 +176,38 @@ def test_observation_persistence_and_expected_update_rate() -> None:
     assert not lc.is_current(2.1)
 
 
+def test_an_observation_given_as_a_function_is_made_only_when_an_update_uses_it() -> None:
+    lc = _obstacle_costmap()
+    layer = lc.plugin("obstacle_layer")
+    made: list[float] = []
+
+    def cloud(x: float) -> object:
+        def make() -> list[list[float]]:
+            made.append(x)
+            return [[x, 1.5, 0.2]]
+
+        return make
+
+    # three scans between two updates (persistence 0): only the newest is projected
+    for k, x in enumerate((3.5, 4.5, 5.5)):
+        layer.add_observation("scan", [1.5, 1.5, 0.1], cloud(x), float(k), float(k))  # type: ignore[attr-defined]
+    assert made == []
+    lc.update_map(1.5, 1.5, 0.0)
+    assert made == [5.5] and lc.costmap.get_cost(5, 1) == LETHAL_OBSTACLE
+    assert lc.costmap.get_cost(3, 1) == FREE_SPACE
+    lc.update_map(1.5, 1.5, 0.0)  # used again: made once
+    assert made == [5.5]
+
+    # points that cannot be made: the observation is dropped and told, the update goes on
+    def broken() -> object:
+        raise CostmapError("laser scan: 3 ranges but 4 angles")
+
+    layer.add_observation("scan", [1.5, 1.5, 0.1], broken, 5.0, 5.0)  # type: ignore[attr-defined]
+    lc.update_map(1.5, 1.5, 0.0)
+    assert layer.sensor_warnings == ["scan dropped: laser scan: 3 ranges but 4 angles"]  # type: ignore[attr-defined]
+    assert layer.buffers["scan"].observations == []  # type: ignore[attr-defined]
+
+
 def test_footprint_clearing_and_overwrite_combination(map10: np.ndarray) -> None:
     values = {
         "robot_radius": 0.9, "footprint_padding": 0.0, "track_unknown_space": True,

@@ -103,6 +103,35 @@ def test_costmap_node_publishes_the_costmap_updates_and_footprint() -> None:
     ctx.shutdown()
 
 
+def test_costmap_and_footprint_messages_are_built_only_for_a_reader() -> None:
+    ctx = Context()
+    _world(ctx, SE2(2.0, 5.0, 0.0))
+    cm_node = Costmap2DNode(ctx, parameter_overrides=_params())
+    ros = cm_node.costmap_ros
+    built: list[str] = []
+    real = ros._publisher.next_message
+
+    def counted(*args: Any, **kwargs: Any) -> Any:
+        built.append("costmap")
+        return real(*args, **kwargs)
+
+    ros._publisher.next_message = counted  # type: ignore[method-assign]
+    ctx.spin_for(1.5)
+    assert ros.updates >= 5 and built == []  # updated, nothing published
+    maps: list[Any] = []
+    feet: list[Any] = []
+    sub = ctx.create_node("listener")
+    sub.create_subscription(OccupancyGrid, "/costmap_2d_node/costmap/costmap", maps.append, LATCHED)
+    sub.create_subscription(
+        "geometry_msgs/msg/PolygonStamped", "/costmap_2d_node/costmap/footprint", feet.append, 10
+    )
+    ctx.spin_for(1.0)
+    # a reader that came late gets the whole grid, and the footprint every update
+    assert built and maps and occupancy_grid_to_array(maps[0]).shape == (100, 100)
+    assert len(feet) >= 4
+    ctx.shutdown()
+
+
 def test_bad_costmap_parameter_fails_the_node_with_its_name() -> None:
     ctx = Context()
     with pytest.raises(NavigationParamsError, match="costmap: update_frequency must be >= 0"):

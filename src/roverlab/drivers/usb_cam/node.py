@@ -34,7 +34,7 @@ from roverlab.drivers.usb_cam.calibration import CameraCalibration, load_calibra
 from roverlab.drivers.usb_cam.capture import IO_METHODS, FrameSource, open_source
 from roverlab.msgs import array_to_image
 from roverlab.msgs import classes as mc
-from roverlab.perception.image_transport.node import CompressedPublisher
+from roverlab.perception.image_transport.publisher import CompressedPublisher
 
 __all__ = ["UsbCamNode"]
 

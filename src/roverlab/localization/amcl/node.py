@@ -112,12 +112,15 @@ class AmclNode(Node):
         for f in dataclasses.fields(AmclParams):  # odom_model_type before the alphas
             default = AmclParams.default_of(f.name, str(values.get("odom_model_type", "")))
             values[f.name] = self.declare_parameter(f.name, default).value
+        self.rng = np.random.default_rng(int(self.declare_parameter("seed", 0).value))
+        for key in self.unused_parameter_overrides():  # names amcl does not read: warned
+            if "/" not in key and "." not in key:  # about once each, by from_ros
+                values[key] = self.declare_parameter(key, None).value
         warnings: list[str] = []
         self.params = AmclParams.from_ros(values, warnings=warnings)
         for w in warnings:
             self.get_logger().warning(w)
         p = self.params
-        self.rng = np.random.default_rng(int(self.declare_parameter("seed", 0).value))
         self.global_frame = _strip(p.global_frame_id)
         self.odom_frame = _strip(p.odom_frame_id)
         self.base_frame = _strip(p.base_frame_id)

@@ -4,7 +4,8 @@ where roverlab chose better ones; see :class:`AmclParams`).
 Every ``<param>`` an amcl ``.launch`` or ``amcl_params.yaml`` sets is a field of
 :class:`AmclParams`, named as ROS names it (``min_particles``, ``laser_z_hit``,
 ``odom_alpha1``, ...), so a launch file's whole set can be passed to
-:meth:`AmclParams.from_ros`; a misspelt name is an error, not silently ignored. The
+:meth:`AmclParams.from_ros`; a name amcl does not read is ignored, as ROS does, with a
+warning naming it (and the closest known name, for a misspelling). The
 node-level ones (frames, rates, map source, TF) are fields too: the filter does not use
 them, the node does.
 
@@ -14,13 +15,12 @@ Units are SI: metres, radians, seconds, hertz.
 from __future__ import annotations
 
 import dataclasses
-import difflib
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, Final
 
-from roverlab.core.rosparams import FieldKinds
+from roverlab.core.rosparams import FieldKinds, unknown_warning
 from roverlab.localization.amcl.errors import AmclParamsError
 
 __all__ = [
@@ -260,19 +260,19 @@ class AmclParams:
 
         Integers given for float parameters are accepted (``value="1"``), and integral
         floats for integer ones; :data:`IGNORED_PARAMETERS` are dropped; any other unknown
-        name is an error naming the closest known one. An unknown ``laser_model_type`` is
-        replaced by ``likelihood_field`` with a warning appended to ``warnings``, as amcl
+        name is ignored, as ROS ignores a parameter amcl does not read, with a warning
+        naming it (and the closest known name) appended to ``warnings``. An unknown
+        ``laser_model_type`` is replaced by ``likelihood_field`` with a warning, as amcl
         does ("Unknown laser model type ...; defaulting to likelihood_field model").
 
         Raises:
-            AmclParamsError: an unknown name or a bad value.
+            AmclParamsError: a bad value.
         """
         names = [f.name for f in dataclasses.fields(cls)]
+        told = warnings if warnings is not None else []
 
-        def unknown(key: str) -> AmclParamsError:
-            near = difflib.get_close_matches(key, names, n=1)
-            hint = f" (did you mean {near[0]!r}?)" if near else ""
-            return AmclParamsError(f"unknown amcl parameter {key!r}{hint}")
+        def unknown(key: str) -> None:
+            told.append(unknown_warning("amcl", key, names))
 
         kwargs = _KINDS.kwargs(params, names, ignored=IGNORED_PARAMETERS, unknown=unknown)
         model = kwargs.get("laser_model_type")

@@ -17,13 +17,18 @@ from roverlab.maps.raytrace import trace_segment_cells
 
 __all__ = [
     "bresenham",
+    "cells_cost",
     "clear_rays",
     "convex_fill",
+    "footprint_cells",
     "footprint_cost",
     "inflate",
     "line_cost",
+    "mark_observation",
     "mark_points",
     "outline_cells",
+    "raytrace_freespace",
+    "scan_points",
 ]
 
 _jit = numba.njit(cache=True, nogil=True)
@@ -150,21 +155,189 @@ def clear_rays(
     """Free every cell each ray ``(gx0, gy0) -> ends[k]`` (cell units) crosses, up to
     ``max_cells`` from the origin; the rays are traced by roverlab's shared grid tracer
     (:func:`roverlab.maps.raytrace.trace_segment_cells`) and clipped to the grid."""
+    for k in range(ends.shape[0]):
+        _clear_ray(grid, gx0, gy0, ends[k, 0], ends[k, 1], max_cells, free_value, buf)
+
+
+@_jit
+def _clear_ray(
+    grid: NDArray[np.uint8],
+    gx0: float,
+    gy0: float,
+    ex: float,
+    ey: float,
+    max_cells: float,
+    free_value: int,
+    buf: NDArray[np.int64],
+) -> None:
     h, w = grid.shape
     flat = grid.reshape(-1)
-    for k in range(ends.shape[0]):
-        ex = ends[k, 0]
-        ey = ends[k, 1]
-        dx = ex - gx0
-        dy = ey - gy0
-        d = math.hypot(dx, dy)
-        if d > max_cells and d > 0.0:
-            s = max_cells / d
-            ex = gx0 + dx * s
-            ey = gy0 + dy * s
-        n = trace_segment_cells(gx0, gy0, ex, ey, w, h, buf)
-        for q in range(n):
-            flat[buf[q]] = free_value
+    dx = ex - gx0
+    dy = ey - gy0
+    d = math.hypot(dx, dy)
+    if d > max_cells and d > 0.0:
+        s = max_cells / d
+        ex = gx0 + dx * s
+        ey = gy0 + dy * s
+    n = trace_segment_cells(gx0, gy0, ex, ey, w, h, buf)
+    for q in range(n):
+        flat[buf[q]] = free_value
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def raytrace_freespace(
+    grid: NDArray[np.uint8],
+    points: NDArray[np.float64],
+    ox: float,
+    oy: float,
+    x0: float,
+    y0: float,
+    x1: float,
+    y1: float,
+    res: float,
+    raytrace_range: float,
+    free_value: int,
+    buf: NDArray[np.int64],
+    bounds: NDArray[np.float64],
+) -> int:
+    """costmap_2d's ``ObstacleLayer::raytraceFreespace`` for one observation seen from
+    ``(ox, oy)`` (inside the map ``[x0, x1) x [y0, y1)``, m): each point's ray is clipped
+    to the map (costmap_2d's order of the four sides; a ray whose clipped end is not
+    finite or not on the map is skipped), its cells up to ``raytrace_range`` are set to
+    ``free_value`` (:func:`clear_rays`), and ``bounds`` (min x, min y, max x, max y) takes
+    the rays' ends cut at ``raytrace_range`` (``updateRaytraceBounds``). Returns the rays
+    traced (``bounds`` untouched when 0)."""
+    gx0 = (ox - x0) / res
+    gy0 = (oy - y0) / res
+    max_cells = raytrace_range / res
+    n = 0
+    for k in range(points.shape[0]):
+        wx = points[k, 0]
+        wy = points[k, 1]
+        a = wx - ox
+        b = wy - oy
+        if wx < x0:
+            t = (x0 - ox) / a
+            wx, wy = x0, oy + b * t
+        if wy < y0:
+            t = (y0 - oy) / b
+            wx, wy = ox + a * t, y0
+        if wx > x1:
+            t = (x1 - ox) / a
+            wx, wy = x1 - 0.001, oy + b * t
+        if wy > y1:
+            t = (y1 - oy) / b
+            wx, wy = ox + a * t, y1 - 0.001
+        if not (
+            math.isfinite(wx) and math.isfinite(wy) and wx >= x0 and wy >= y0 and wx < x1
+            and wy < y1
+        ):  # fmt: skip
+            continue
+        _clear_ray(grid, gx0, gy0, (wx - x0) / res, (wy - y0) / res, max_cells, free_value, buf)
+        dx = wx - ox
+        dy = wy - oy
+        full = math.hypot(dx, dy)
+        scale = min(1.0, raytrace_range / full) if full > 0 else 1.0
+        ex = ox + dx * scale
+        ey = oy + dy * scale
+        if n == 0:
+            bounds[0] = bounds[2] = ex
+            bounds[1] = bounds[3] = ey
+        else:
+            bounds[0] = min(bounds[0], ex)
+            bounds[1] = min(bounds[1], ey)
+            bounds[2] = max(bounds[2], ex)
+            bounds[3] = max(bounds[3], ey)
+        n += 1
+    return n
+
+
+@_jit
+def mark_observation(
+    grid: NDArray[np.uint8],
+    points: NDArray[np.float64],
+    origin: NDArray[np.float64],
+    max_obstacle_height: float,
+    obstacle_range: float,
+    gx: float,
+    gy: float,
+    res: float,
+    value: int,
+    bounds: NDArray[np.float64],
+) -> int:
+    """costmap_2d's marking of one observation: each point no higher than
+    ``max_obstacle_height``, closer (3-D) than ``obstacle_range`` to ``origin`` and on the
+    grid (origin ``(gx, gy)``) sets its cell to ``value``; ``bounds`` (min x, min y, max
+    x, max y) takes the marked points. Returns the points marked (``bounds`` untouched when
+    0)."""
+    h, w = grid.shape
+    r2 = obstacle_range * obstacle_range
+    n = 0
+    for k in range(points.shape[0]):
+        px = points[k, 0]
+        py = points[k, 1]
+        pz = points[k, 2]
+        dx = px - origin[0]
+        dy = py - origin[1]
+        dz = pz - origin[2]
+        if not (pz <= max_obstacle_height and (dx * dx + dy * dy) + dz * dz < r2):
+            continue
+        if not (px >= gx and py >= gy):
+            continue
+        mx = int((px - gx) / res)
+        my = int((py - gy) / res)
+        if mx >= w or my >= h:
+            continue
+        grid[my, mx] = value
+        if n == 0:
+            bounds[0] = bounds[2] = px
+            bounds[1] = bounds[3] = py
+        else:
+            bounds[0] = min(bounds[0], px)
+            bounds[1] = min(bounds[1], py)
+            bounds[2] = max(bounds[2], px)
+            bounds[3] = max(bounds[3], py)
+        n += 1
+    return n
+
+
+@_jit
+def scan_points(
+    ranges: NDArray[np.float32],
+    cos_a: NDArray[np.float64],
+    sin_a: NDArray[np.float64],
+    range_min: float,
+    range_max: float,
+    inf_is_valid: bool,
+    rotation: NDArray[np.float64],
+    translation: NDArray[np.float64],
+) -> NDArray[np.float64]:
+    """A LaserScan's points in another frame: laser_geometry's projection (readings in
+    ``[range_min, range_max)``, NaN dropped; with ``inf_is_valid`` +inf counts as
+    ``range_max - 0.0001``) of beams at angles with cosines ``cos_a`` and sines ``sin_a``,
+    rotated by the quaternion ``rotation`` (x, y, z, w) and moved by ``translation``, with
+    the arithmetic of :meth:`roverlab.geometry.Transform3.apply` (the same values).
+    ``(N, 3)``, in beam order."""
+    x, y, z, w = rotation[0], rotation[1], rotation[2], rotation[3]
+    out = np.empty((ranges.shape[0], 3))
+    n = 0
+    for i in range(ranges.shape[0]):
+        r = float(ranges[i])
+        if inf_is_valid and r == np.inf:
+            r = range_max - 1e-4
+        if not (r >= range_min and r < range_max):
+            continue
+        px = r * cos_a[i]
+        py = r * sin_a[i]
+        pz = 0.0
+        t0 = 2.0 * (y * pz - z * py)
+        t1 = 2.0 * (z * px - x * pz)
+        t2 = 2.0 * (x * py - y * px)
+        out[n, 0] = ((px + w * t0) + (y * t2 - z * t1)) + translation[0]
+        out[n, 1] = ((py + w * t1) + (z * t0 - x * t2)) + translation[1]
+        out[n, 2] = ((pz + w * t2) + (x * t1 - y * t0)) + translation[2]
+        n += 1
+    return out[:n]
 
 
 @_jit
@@ -285,6 +458,75 @@ def inflate(
 
 
 @_jit
+def footprint_cells(
+    w: int,
+    h: int,
+    res: float,
+    ox: float,
+    oy: float,
+    x: float,
+    y: float,
+    c: float,
+    s: float,
+    fp: NDArray[np.float64],
+    scale: float,
+    out: NDArray[np.int64],
+) -> bool:
+    """The cells :func:`footprint_cost` reads at ``(x, y, th)`` (``c``, ``s``: ``cos th``,
+    ``sin th``): ``out[0]`` the centre's
+    ``(mx, my)``, ``out[1 + k]`` vertex ``k``'s (of ``fp`` scaled by ``scale``; none
+    when ``fp`` has fewer than 3 points). False (``out`` partly written) when the centre
+    or a vertex is off the ``w`` x ``h`` grid. The cost depends on these cells only, so
+    two poses with the same cells cost the same."""
+    if x < ox or y < oy:
+        return False
+    cx = int((x - ox) / res)
+    cy = int((y - oy) / res)
+    if cx >= w or cy >= h:
+        return False
+    out[0, 0] = cx
+    out[0, 1] = cy
+    m = fp.shape[0]
+    if m < 3:
+        return True
+    for k in range(m):
+        wx = x + scale * (fp[k, 0] * c - fp[k, 1] * s)
+        wy = y + scale * (fp[k, 0] * s + fp[k, 1] * c)
+        if wx < ox or wy < oy:
+            return False
+        mx = int((wx - ox) / res)
+        my = int((wy - oy) / res)
+        if mx >= w or my >= h:
+            return False
+        out[k + 1, 0] = mx
+        out[k + 1, 1] = my
+    return True
+
+
+@_jit
+def cells_cost(
+    costs: NDArray[np.uint8], cells: NDArray[np.int64], m: int, buf: NDArray[np.int64]
+) -> float:
+    """:func:`footprint_cost` from :func:`footprint_cells`' cells of an ``m``-point
+    footprint (all on the grid): the highest cost on the outline's Bresenham lines (vertex
+    ``k`` to ``k + 1``, the last edge back to vertex 0) and the centre cell, -6 at a lethal
+    or unknown cell; for ``m < 3`` the centre's cost, -6 from inscribed up."""
+    center = costs[cells[0, 1], cells[0, 0]]
+    if m < 3:
+        if center in (LETHAL, INSCRIBED, NO_INFO):
+            return -6.0
+        return float(center)
+    best = 0.0
+    for k in range(1, m + 1):  # the edge from vertex k - 1 (row k) to vertex k % m
+        b = k % m + 1
+        lc = line_cost(costs, cells[k, 0], cells[k, 1], cells[b, 0], cells[b, 1], buf)
+        if lc < 0:
+            return -6.0
+        best = max(best, lc)
+    return max(best, float(center))
+
+
+@_jit
 def footprint_cost(
     costs: NDArray[np.uint8],
     res: float,
@@ -302,42 +544,10 @@ def footprint_cost(
     outline (and its centre cell), or -6 when a cell is lethal or unknown or the footprint
     leaves the grid. ``buf`` is scratch space for the Bresenham cells."""
     h, w = costs.shape
-    if x < ox or y < oy:
+    cells = np.empty((fp.shape[0] + 1, 2), dtype=np.int64)
+    if not footprint_cells(w, h, res, ox, oy, x, y, math.cos(th), math.sin(th), fp, scale, cells):
         return -6.0
-    cx = int((x - ox) / res)
-    cy = int((y - oy) / res)
-    if cx >= w or cy >= h:
-        return -6.0
-    center = float(costs[cy, cx])
-    m = fp.shape[0]
-    if m < 3:
-        c = costs[cy, cx]
-        if c in (LETHAL, INSCRIBED, NO_INFO):
-            return -6.0
-        return center
-    c = math.cos(th)
-    s = math.sin(th)
-    best = 0.0
-    px0 = 0
-    py0 = 0
-    for k in range(m + 1):
-        j = k % m
-        wx = x + scale * (fp[j, 0] * c - fp[j, 1] * s)
-        wy = y + scale * (fp[j, 0] * s + fp[j, 1] * c)
-        if wx < ox or wy < oy:
-            return -6.0
-        mx = int((wx - ox) / res)
-        my = int((wy - oy) / res)
-        if mx >= w or my >= h:
-            return -6.0
-        if k > 0:
-            lc = line_cost(costs, px0, py0, mx, my, buf)
-            if lc < 0:
-                return -6.0
-            best = max(best, lc)
-        px0 = mx
-        py0 = my
-    return max(best, center)
+    return cells_cost(costs, cells, fp.shape[0], buf)
 
 
 @_jit

@@ -13,23 +13,26 @@ host's ``NAME/`` (both ROS spellings, see :mod:`.params`; ``footprint`` and
   no older than ``transform_tolerance``), updates the layered costmap, publishes the padded
   footprint on ``~NAME/footprint`` (``geometry_msgs/PolygonStamped``) and, every
   ``1 / publish_frequency`` s, the costmap on ``~NAME/costmap`` (``OccupancyGrid``) or the
-  changed window on ``~NAME/costmap_updates`` (``map_msgs/OccupancyGridUpdate``).
+  changed window on ``~NAME/costmap_updates`` (``map_msgs/OccupancyGridUpdate``); messages
+  nobody subscribes to are not built (a reader that comes later gets a whole grid first).
 """
 
 from __future__ import annotations
 
+import functools
 from typing import Any
 
 import numpy as np
 
 from roverlab.core import Context, Node, QoSProfile, Time
 from roverlab.geometry import SE2, Transform3
-from roverlab.msgs import OccupancyGrid, PolygonStamped, get_type, pointcloud2_to_xyz, scan_angles
+from roverlab.msgs import OccupancyGrid, PolygonStamped, get_type, pointcloud2_to_xyz
 from roverlab.msgs import classes as mc
 from roverlab.navigation.costmap.costmap_2d import Costmap2D
 from roverlab.navigation.costmap.footprint import transform_footprint
+from roverlab.navigation.costmap.kernels import scan_points
 from roverlab.navigation.costmap.layered import LayeredCostmap
-from roverlab.navigation.costmap.obstacle_layer import ObstacleLayer, project_scan
+from roverlab.navigation.costmap.obstacle_layer import ObstacleLayer
 from roverlab.navigation.costmap.params import CostmapParams, make_layered_costmap
 from roverlab.navigation.costmap.publisher import CostmapPublisherState, footprint_message
 from roverlab.navigation.costmap.static_layer import StaticLayer
@@ -172,23 +175,32 @@ class Costmap2DROS:
                 "tf-" + source, f"{self.name}: observation of {source} dropped: {err}"
             )
             return
-        try:
-            if sp.data_type == "LaserScan":
-                pts = project_scan(
-                    np.asarray(msg.ranges, dtype=np.float64),
-                    scan_angles(msg),
-                    float(msg.range_min),
-                    float(msg.range_max),
-                    inf_is_valid=sp.inf_is_valid,
+        data_type, inf_is_valid = sp.data_type, sp.inf_is_valid
+
+        def points() -> np.ndarray:  # made when an update first uses the observation
+            if data_type == "LaserScan":
+                ranges = np.asarray(msg.ranges)
+                if ranges.dtype != np.float32 and ranges.dtype != np.float64:
+                    ranges = ranges.astype(np.float64)
+                cos_a, sin_a = _beam_trig(
+                    float(msg.angle_min), float(msg.angle_increment), len(ranges)
                 )
-            elif sp.data_type == "PointCloud2":
+                # project_scan then g_T_msg.apply, in one compiled pass (the same values)
+                return scan_points(
+                    ranges, cos_a, sin_a, float(msg.range_min), float(msg.range_max),
+                    inf_is_valid, np.asarray(g_T_msg.rotation, dtype=np.float64),
+                    np.asarray(g_T_msg.translation, dtype=np.float64),
+                )  # fmt: skip
+            if data_type == "PointCloud2":
                 pts = pointcloud2_to_xyz(msg, skip_nans=True).astype(np.float64)
             else:
                 pts = np.array([[p.x, p.y, p.z] for p in msg.points], dtype=np.float64)
-            world = _apply(g_T_msg, pts)
+            return _apply(g_T_msg, pts)
+
+        try:
             origin = np.asarray(g_T_sensor.translation, dtype=np.float64)
             now = self.node.get_clock().now().nanoseconds / 1e9
-            layer.add_observation(source, origin, world, stamp.nanoseconds / 1e9, now)
+            layer.add_observation(source, origin, points, stamp.nanoseconds / 1e9, now)
         except (NavigationError, ValueError) as err:
             self._throttle.warning("obs-" + source, f"{self.name}: {source} dropped: {err}")
 
@@ -292,8 +304,9 @@ class Costmap2DROS:
             if isinstance(layer, ObstacleLayer) and layer.sensor_warnings:
                 self._throttle.warning("sensor", f"{self.name}: {layer.sensor_warnings[-1]}")
                 layer.sensor_warnings.clear()
-        gf = self.params.global_frame
-        self.footprint_pub.publish(footprint_message(self.oriented_footprint(pose), gf, now))
+        if self.footprint_pub.has_listeners:  # a message each update: only for a reader
+            gf = self.params.global_frame
+            self.footprint_pub.publish(footprint_message(self.oriented_footprint(pose), gf, now))
         p = self.params
         if p.publish_frequency > 0 and self.layered.initialized:
             x0, xn, y0, yn = self.layered.bounds_cells
@@ -304,7 +317,11 @@ class Costmap2DROS:
                 self._last_publish_ns = now.nanoseconds
 
     def publish(self) -> None:
-        """Publish the costmap (whole, or the window changed since the last time)."""
+        """Publish the costmap (whole, or the window changed since the last time). With no
+        reader of either topic nothing is built, and the next message is a whole grid."""
+        if not (self.costmap_pub.has_listeners or self.update_pub.has_listeners):
+            self._publisher.force_full()
+            return
         now = self.node.get_clock().now()
         kind, msg = self._publisher.next_message(self.costmap, self.params.global_frame, now)
         if kind == "full":
@@ -324,6 +341,16 @@ class Costmap2DROS:
     def start(self) -> None:
         """Resume updating."""
         self._stopped = False
+
+
+@functools.lru_cache(maxsize=16)
+def _beam_trig(angle_min: float, increment: float, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """Cosine and sine of each beam's angle (``scan_angles``), computed once per scan
+    geometry (read-only)."""
+    angles = angle_min + np.arange(count, dtype=np.float64) * increment
+    cos_a, sin_a = np.cos(angles), np.sin(angles)
+    cos_a.flags.writeable = sin_a.flags.writeable = False
+    return cos_a, sin_a
 
 
 def _apply(tf: Transform3, pts: np.ndarray) -> np.ndarray:

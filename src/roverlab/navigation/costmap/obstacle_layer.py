@@ -16,10 +16,16 @@ sensor origin, filtered to ``[min_obstacle_height, max_obstacle_height]``. At ev
 The layer's costs go to the master by ``combination_method`` (0 overwrite, 1 maximum, any
 other value: not at all). ``observation_persistence`` keeps observations that long (0: only
 the latest); ``expected_update_rate`` makes the layer not current when a source is late.
+
+An observation may be buffered as a function that makes its points: it is called only
+when an update uses the observation, so a 50 Hz laser read by a 5 Hz costmap with
+``observation_persistence`` 0 is projected 5 times a second, not 50 (the points are the
+same as if projected on arrival; ROS projects every scan as it comes).
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -32,7 +38,7 @@ from roverlab.navigation.costmap.costmap_2d import (
     Costmap2D,
 )
 from roverlab.navigation.costmap.footprint import transform_footprint
-from roverlab.navigation.costmap.kernels import clear_rays, mark_points
+from roverlab.navigation.costmap.kernels import mark_observation, raytrace_freespace
 from roverlab.navigation.costmap.layered import Bounds, CostmapLayer
 from roverlab.navigation.errors import CostmapError
 from roverlab.navigation.params import check
@@ -162,33 +168,55 @@ def project_scan(
     return np.column_stack([r * np.cos(a), r * np.sin(a), np.zeros_like(r)])
 
 
+#: Points of an observation, or a function making them (called once, when first used).
+PointSource = ArrayLike | Callable[[], ArrayLike]
+
+
+@dataclass(frozen=True, slots=True)
+class _Pending:
+    """An observation whose points are not made yet (see the module docstring)."""
+
+    origin: NDArray[np.float64]
+    make: Callable[[], ArrayLike]
+    stamp_s: float
+
+
 class ObservationBuffer:
     """costmap_2d's ``ObservationBuffer`` for one source."""
 
     def __init__(self, params: ObservationSourceParams) -> None:
         self.params = params
-        self.observations: list[Observation] = []
+        self.observations: list[Observation | _Pending] = []
         self.last_updated_s: float | None = None
 
     def buffer_points(
-        self, origin: ArrayLike, points: ArrayLike, stamp_s: float, now_s: float
+        self, origin: ArrayLike, points: PointSource, stamp_s: float, now_s: float
     ) -> None:
         """Add a cloud (global frame) seen from ``origin`` at ``stamp_s``; ``now_s`` is the
-        clock time (for ``expected_update_rate``)."""
+        clock time (for ``expected_update_rate``). ``points`` may be a function returning
+        the cloud: it is called when an update first uses the observation (never, when a
+        newer one replaces it first)."""
         o = np.asarray(origin, dtype=np.float64).reshape(3)
-        pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
         if not np.isfinite(o).all():
             raise CostmapError(f"observation {self.params.name}: sensor origin is not finite")
+        if callable(points):
+            obs: Observation | _Pending = _Pending(o, points, float(stamp_s))
+        else:
+            obs = self._observation(o, points, float(stamp_s))
+        self.observations.insert(0, obs)
+        self.last_updated_s = float(now_s)
+        self._purge()
+
+    def _observation(
+        self, origin: NDArray[np.float64], points: ArrayLike, stamp_s: float
+    ) -> Observation:
+        pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
         p = self.params
         z = pts[:, 2]
         with np.errstate(invalid="ignore"):
             keep = (z <= p.max_obstacle_height) & (z >= p.min_obstacle_height)
         keep &= np.isfinite(pts).all(axis=1)
-        self.observations.insert(
-            0, Observation(o, pts[keep], p.obstacle_range, p.raytrace_range, float(stamp_s))
-        )
-        self.last_updated_s = float(now_s)
-        self._purge()
+        return Observation(origin, pts[keep], p.obstacle_range, p.raytrace_range, stamp_s)
 
     def _purge(self) -> None:
         if not self.observations:
@@ -201,9 +229,21 @@ class ObservationBuffer:
         self.observations = [o for o in self.observations if latest - o.stamp_s <= keep]
 
     def get_observations(self) -> list[Observation]:
-        """The observations kept (newest first)."""
+        """The observations kept (newest first); points still to be made are made now.
+
+        Raises:
+            CostmapError: an observation whose points could not be made (it is dropped).
+        """
         self._purge()
-        return list(self.observations)
+        obs = self.observations
+        for i, o in enumerate(obs):
+            if isinstance(o, _Pending):
+                try:
+                    obs[i] = self._observation(o.origin, o.make(), o.stamp_s)
+                except (CostmapError, ValueError) as err:
+                    del obs[i]
+                    raise CostmapError(f"{self.params.name} dropped: {err}") from err
+        return list(obs)  # type: ignore[arg-type]  # every entry made above
 
     def is_current(self, now_s: float) -> bool:
         """Updated within ``expected_update_rate`` (always, when it is 0)."""
@@ -236,6 +276,7 @@ class ObstacleLayer(CostmapLayer):
         self.sensor_warnings: list[str] = []
         self._footprint = np.zeros((0, 2))
         self._trace_buf = np.empty(0, dtype=np.int64)
+        self._box = np.zeros(4)  # min x, min y, max x, max y of a kernel's cells
 
     def on_initialize(self) -> None:
         track = self.params.track_unknown_space
@@ -256,9 +297,10 @@ class ObstacleLayer(CostmapLayer):
         )
 
     def add_observation(
-        self, source: str, origin: ArrayLike, points: ArrayLike, stamp_s: float, now_s: float
+        self, source: str, origin: ArrayLike, points: PointSource, stamp_s: float, now_s: float
     ) -> None:
-        """Buffer a cloud of source ``source`` (global frame, seen from ``origin``)."""
+        """Buffer a cloud of source ``source`` (global frame, seen from ``origin``; or a
+        function making it, see :meth:`ObservationBuffer.buffer_points`)."""
         try:
             buf = self.buffers[source]
         except KeyError:
@@ -275,11 +317,11 @@ class ObstacleLayer(CostmapLayer):
         self.use_extra_bounds(bounds)
         for buf in self.buffers.values():
             if buf.params.clearing:
-                for obs in buf.get_observations():
+                for obs in self._observations(buf):
                     self._raytrace_freespace(obs, bounds)
         for buf in self.buffers.values():
             if buf.params.marking:
-                for obs in buf.get_observations():
+                for obs in self._observations(buf):
                     self._mark(obs, bounds)
         if self.params.footprint_clearing_enabled and len(self.layered.footprint) >= 3:
             self._footprint = transform_footprint(
@@ -288,26 +330,27 @@ class ObstacleLayer(CostmapLayer):
             for x, y in self._footprint:
                 bounds.touch(float(x), float(y))
 
+    def _observations(self, buf: ObservationBuffer) -> list[Observation]:
+        """The buffer's observations; one whose points cannot be made is dropped (told in
+        ``sensor_warnings``), as the node drops a message it cannot convert."""
+        while True:
+            try:
+                return buf.get_observations()
+            except CostmapError as err:
+                self.sensor_warnings.append(str(err))
+
     def _mark(self, obs: Observation, bounds: Bounds) -> None:
         pts = obs.points
         if len(pts) == 0:
             return
         g = self.grid
-        d2 = np.sum((pts - obs.origin) ** 2, axis=1)
-        keep = (pts[:, 2] <= self.params.max_obstacle_height) & (
-            d2 < obs.obstacle_range * obs.obstacle_range
-        )
-        keep &= (pts[:, 0] >= g.origin_x) & (pts[:, 1] >= g.origin_y)
-        p = pts[keep]
-        mx = ((p[:, 0] - g.origin_x) / g.resolution).astype(np.int64)
-        my = ((p[:, 1] - g.origin_y) / g.resolution).astype(np.int64)
-        inside = (mx < g.size_x) & (my < g.size_y)
-        if not inside.any():
-            return
-        mark_points(g.costs, np.column_stack([mx[inside], my[inside]]), LETHAL_OBSTACLE)
-        p = p[inside]
-        bounds.touch(float(p[:, 0].min()), float(p[:, 1].min()))
-        bounds.touch(float(p[:, 0].max()), float(p[:, 1].max()))
+        box = self._box
+        if mark_observation(
+            g.costs, pts, obs.origin, self.params.max_obstacle_height, obs.obstacle_range,
+            g.origin_x, g.origin_y, g.resolution, LETHAL_OBSTACLE, box,
+        ):  # fmt: skip
+            bounds.touch(float(box[0]), float(box[1]))
+            bounds.touch(float(box[2]), float(box[3]))
 
     def _raytrace_freespace(self, obs: Observation, bounds: Bounds) -> None:
         g = self.grid
@@ -319,53 +362,22 @@ class ObstacleLayer(CostmapLayer):
             )
             return
         bounds.touch(ox, oy)
-        pts = obs.points[:, :2]
+        pts = obs.points
         if len(pts) == 0:
             return
         x0, y0 = g.origin_x, g.origin_y
         x1 = x0 + g.size_x * g.resolution
         y1 = y0 + g.size_y * g.resolution
-        wx, wy = pts[:, 0].copy(), pts[:, 1].copy()
-        a, b = wx - ox, wy - oy
-        with np.errstate(divide="ignore", invalid="ignore"):
-            # clip each ray to the map, in costmap_2d's order
-            m = wx < x0
-            t = (x0 - ox) / a
-            wx, wy = np.where(m, x0, wx), np.where(m, oy + b * t, wy)
-            m = wy < y0
-            t = (y0 - oy) / b
-            wx, wy = np.where(m, ox + a * t, wx), np.where(m, y0, wy)
-            m = wx > x1
-            t = (x1 - ox) / a
-            wx, wy = np.where(m, x1 - 0.001, wx), np.where(m, oy + b * t, wy)
-            m = wy > y1
-            t = (y1 - oy) / b
-            wx, wy = np.where(m, ox + a * t, wx), np.where(m, y1 - 0.001, wy)
-        ok = np.isfinite(wx) & np.isfinite(wy) & (wx >= x0) & (wy >= y0) & (wx < x1) & (wy < y1)
-        wx, wy = wx[ok], wy[ok]
-        if len(wx) == 0:
-            return
         need = g.size_x + g.size_y + 4
         if self._trace_buf.shape[0] < need:
             self._trace_buf = np.empty(need, dtype=np.int64)
-        ends = np.column_stack([(wx - x0) / g.resolution, (wy - y0) / g.resolution])
-        clear_rays(
-            g.costs,
-            (ox - x0) / g.resolution,
-            (oy - y0) / g.resolution,
-            np.ascontiguousarray(ends),
-            obs.raytrace_range / g.resolution,
-            FREE_SPACE,
-            self._trace_buf,
-        )
-        # updateRaytraceBounds: each ray's end, cut at raytrace_range
-        dx, dy = wx - ox, wy - oy
-        full = np.hypot(dx, dy)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            scale = np.where(full > 0, np.minimum(1.0, obs.raytrace_range / full), 1.0)
-        ex, ey = ox + dx * scale, oy + dy * scale
-        bounds.touch(float(ex.min()), float(ey.min()))
-        bounds.touch(float(ex.max()), float(ey.max()))
+        box = self._box
+        if raytrace_freespace(
+            g.costs, pts, ox, oy, x0, y0, x1, y1, g.resolution, obs.raytrace_range,
+            FREE_SPACE, self._trace_buf, box,
+        ):  # fmt: skip
+            bounds.touch(float(box[0]), float(box[1]))
+            bounds.touch(float(box[2]), float(box[3]))
 
     def update_costs(self, master: Costmap2D, x0: int, y0: int, xn: int, yn: int) -> None:
         if self.params.footprint_clearing_enabled and len(self._footprint) >= 3:

@@ -44,6 +44,7 @@ from roverlab.actionlib import SimpleActionServer
 from roverlab.core import Context, Node, Time
 from roverlab.geometry import SE2
 from roverlab.msgs import Path, PoseStamped, Twist, pose_from_xytheta, xytheta_from_pose
+from roverlab.msgs import builders as build
 from roverlab.msgs import classes as mc
 from roverlab.navigation.controllers import Velocity2D
 from roverlab.navigation.costmap.costmap_2d import Costmap2D
@@ -365,10 +366,12 @@ class MoveBase(Node):
         now = self._now()
         gpose = self.global_costmap.get_robot_pose()
         if gpose is not None:
-            fb = PoseStamped(
-                header_frame_id=self.global_frame, pose=pose_from_xytheta(*gpose.as_array())
-            )
-            fb.header.stamp = self.get_clock().now().to_msg()
+            sec, nsec = divmod(self.get_clock().now_ns(), 1_000_000_000)
+            half = 0.5 * float(gpose.theta)  # pose_from_xytheta, in one builder call
+            fb = build.pose_stamped(
+                sec, nsec, self.global_frame, float(gpose.x), float(gpose.y), 0.0,
+                0.0, 0.0, math.sin(half), math.cos(half),
+            )  # fmt: skip
             srv.publish_feedback({"base_position": fb})
             op = self._oscillation_pose
             if (
@@ -530,7 +533,9 @@ class MoveBase(Node):
         if self.recovery_trigger == CONTROLLING_R:
             self.recovery_index = 0
         cmd = self.recovering.limited(cmd, lpose)
-        self.cmd_pub.publish(Twist(linear_x=cmd.vx, linear_y=cmd.vy, angular_z=cmd.wz))
+        self.cmd_pub.publish(
+            build.twist(float(cmd.vx), float(cmd.vy), 0.0, 0.0, 0.0, float(cmd.wz))
+        )
         trajectory = getattr(self.controller, "trajectory", None)
         if trajectory is not None and len(trajectory):
             self._publish_path(

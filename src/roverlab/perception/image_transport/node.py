@@ -1,12 +1,9 @@
 """image_transport's nodes: the ``compressed`` publisher a camera driver offers beside its
 raw image, and ``image_transport/republish``.
 
-* :class:`CompressedPublisher`: ``<topic>/compressed`` (sensor_msgs/CompressedImage) next to
-  a raw ``<topic>``, compressed only while someone subscribes to it, as an
-  image_transport publisher. Its parameters are the node's
-  ``<topic>.compressed.format`` / ``.jpeg_quality`` / ``.png_level`` (ROS 2's
-  image_transport names; ROS 1 keeps them under ``<topic>/compressed/``), e.g.
-  ``camera.image_raw.compressed.jpeg_quality`` for ``/camera/image_raw``.
+* :class:`CompressedPublisher` (in :mod:`.publisher`, re-exported here):
+  ``<topic>/compressed`` next to a raw ``<topic>``, compressed only while someone
+  subscribes to it.
 * :class:`Republish`: ``rosrun image_transport republish IN_TRANSPORT in:=IN
   [OUT_TRANSPORT] out:=OUT``: ``raw`` -> ``compressed`` reads ``in`` and publishes
   ``out/compressed`` (private ``format``, ``jpeg_quality``, ``png_level``), ``compressed``
@@ -17,69 +14,21 @@ from __future__ import annotations
 
 from typing import Any
 
-import numpy as np
-
 from roverlab.core import Context, Node
-from roverlab.msgs import array_to_image, image_to_array
+from roverlab.msgs import array_to_image
 from roverlab.msgs import classes as mc
 from roverlab.perception.image_transport.codec import (
-    CompressedParams,
     ImageTransportError,
     check_transport,
-    compress,
     decompress,
+)
+from roverlab.perception.image_transport.publisher import (
+    CompressedPublisher,
+    compressed_message,
+    compressed_params,
 )
 
 __all__ = ["CompressedPublisher", "Republish", "compressed_message"]
-
-
-def compressed_message(image: Any, params: CompressedParams) -> Any:
-    """The CompressedImage of a ``sensor_msgs/Image`` (same header).
-
-    Raises:
-        ImageTransportError: an encoding the format cannot hold.
-    """
-    fmt, data = compress(image_to_array(image), str(image.encoding), params)
-    return mc.CompressedImage(
-        header=image.header, format=fmt, data=np.frombuffer(data, dtype=np.uint8)
-    )
-
-
-def _params(node: Node, prefix: str) -> CompressedParams:
-    p = node.declare_parameter
-    return CompressedParams(
-        format=str(p(f"{prefix}format", "jpeg").value),
-        jpeg_quality=int(p(f"{prefix}jpeg_quality", 80).value),
-        png_level=int(p(f"{prefix}png_level", 9).value),
-    )
-
-
-class CompressedPublisher:
-    """``topic``/compressed beside a raw image topic of ``node``.
-
-    Args:
-        node: the camera driver's node.
-        topic: the raw image's topic as the node names it (``~/image_raw``,
-            ``/camera/image_raw``).
-        depth: the publisher's queue depth.
-
-    Raises:
-        ImageTransportError: a bad format parameter.
-    """
-
-    def __init__(self, node: Node, topic: str, depth: int = 1) -> None:
-        base = node.resolve_topic_name(topic)
-        self.params = _params(node, f"{base.strip('/').replace('/', '.')}.compressed.")
-        self.publisher = node.create_publisher(mc.CompressedImage, f"{base}/compressed", depth)
-
-    @property
-    def has_listeners(self) -> bool:
-        return self.publisher.has_listeners
-
-    def publish(self, image: Any) -> None:
-        """Compress and publish ``image`` if anyone subscribes (else nothing is done)."""
-        if self.publisher.has_listeners:
-            self.publisher.publish(compressed_message(image, self.params))
 
 
 class Republish(Node):
@@ -113,7 +62,7 @@ class Republish(Node):
         if out == in_transport:
             raise ImageTransportError(f"republish {in_transport} to {out}: nothing to convert")
         super().__init__(node_name, context=context, **node_kwargs)
-        self.params = _params(self, "")
+        self.params = compressed_params(self, "")
         self.republished = 0
         self._last_error = ""
         # the base topics are resolved (remapped) first, the transport's suffix added after

@@ -35,7 +35,12 @@ from roverlab.core.transport.ros1.tcpros import (
     TcprosServer,
     check_md5,
 )
-from roverlab.core.transport.ros1.xmlrpc import advertised_host, bind_host, call
+from roverlab.core.transport.ros1.xmlrpc import (
+    advertised_host,
+    bind_host,
+    call,
+    wait_for_master,
+)
 
 __all__ = ["Ros1Peer", "ServiceSpec", "TopicSpec"]
 
@@ -84,22 +89,30 @@ class _Srv:
 class Ros1Peer:
     """The ROS 1 side of a process, talking to the master at ``master_uri``.
 
+    Args:
+        master_uri: the master's XML-RPC URI.
+        check_master: make sure the master answers before anything else.
+        on_wait: None: an unreachable master is an error (a one-shot tool); else the
+            peer waits for it as a ROS node does, telling ``on_wait`` (see
+            :func:`wait_for_master`).
+
     Raises:
-        MasterError: no master answers at ``master_uri`` (checked once at start).
+        MasterError: no master answers at ``master_uri`` (checked once at start) and
+            ``on_wait`` is None.
     """
 
-    def __init__(self, master_uri: str, *, check_master: bool = True) -> None:
+    def __init__(
+        self,
+        master_uri: str,
+        *,
+        check_master: bool = True,
+        on_wait: Callable[[str], None] | None = None,
+    ) -> None:
         self.master_uri = master_uri
         self.host = advertised_host()
         self.bind = bind_host(self.host)
         if check_master:
-            try:
-                call(master_uri, "getUri", "/roverlab", timeout_s=3.0)
-            except MasterError as err:
-                raise MasterError(
-                    f"no ROS master at {master_uri} ({err}); start one (roscore or "
-                    "roverlab roscore) or fix ROS_MASTER_URI"
-                ) from None
+            wait_for_master(master_uri, on_wait)
         self._lock = threading.RLock()
         self.slaves: dict[str, SlaveServer] = {}
         self.pubs: dict[str, _Pub] = {}

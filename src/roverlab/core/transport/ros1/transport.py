@@ -13,6 +13,7 @@ from __future__ import annotations
 import logging
 import os
 import threading
+from collections.abc import Callable
 from functools import partial
 from typing import TYPE_CHECKING, Any
 
@@ -109,17 +110,22 @@ def topic_spec(typename: str) -> TopicSpec:
 class Ros1Transport:
     """Mirrors a context's nodes and topics into the ROS 1 graph of ``master_uri``.
 
+    Args:
+        master_uri: the master's XML-RPC URI.
+        on_wait: None for a one-shot tool (an unreachable master is an error at once);
+            for a node, where it hears that the master is not up yet while the
+            transport waits for it, as a rospy node does.
+
     Raises:
-        MasterError: no master answers at ``master_uri``.
+        MasterError: no master answers at ``master_uri`` and ``on_wait`` is None.
     """
 
-    def __init__(self, master_uri: str) -> None:
+    def __init__(self, master_uri: str, *, on_wait: Callable[[str], None] | None = None) -> None:
         self.master_uri = master_uri
-        self.peer = Ros1Peer(master_uri)
+        self.peer = Ros1Peer(master_uri, on_wait=on_wait)
         self.params = ParamMirror(master_uri)
-        self.peer.on_param = lambda node, key, value: self.params.update(
-            self._context, node, key, value
-        )
+        self.peer.on_param = self._on_param
+        self._watches: dict[str, list[tuple[str, Callable[[Any], None]]]] = {}
         self._context: Context | None = None
         self._specs: dict[str, TopicSpec] = {}
         self.received = 0
@@ -140,8 +146,9 @@ class Ros1Transport:
     def attach(self, context: Context) -> None:
         self._context = context
         for node in list(context.nodes.values()):  # declared before the transport came
+            uri = self.peer.add_node(node.get_fully_qualified_name())
             for param in list(node.parameters.values()):
-                self.on_parameter(node, param)
+                self.params.declared(node, param, uri, running=True)
         if context.uses_sim_time:  # as Gazebo does: ROS 1 nodes follow our /clock
             try:
                 call(self.master_uri, "setParam", "/roverlab", "/use_sim_time", True)
@@ -153,7 +160,13 @@ class Ros1Transport:
         if added:
             self.peer.add_node(fq)
         else:
-            self.params.forget(fq, self.peer.add_node(fq))
+            uri = self.peer.add_node(fq)
+            self.params.forget(fq, uri)
+            for key, _ in self._watches.pop(fq, []):
+                try:
+                    call(self.master_uri, "unsubscribeParam", fq, uri, key, timeout_s=2.0)
+                except MasterError as err:
+                    _log.debug("unsubscribeParam %s: %s", key, err)
             self.peer.remove_node(fq)
 
     def on_parameter(self, node: Node, param: Parameter) -> None:
@@ -228,9 +241,12 @@ class Ros1Transport:
             self.peer.unsubscribe(fq, topic.name)
 
     def _on_bytes(self, topic: Topic, data: bytes) -> None:
+        """A message from a link's thread: decoded and handed to the callbacks in that
+        thread when the executor is idle (as rospy runs a callback in its connection's
+        thread; still one callback at a time), else queued for the executor."""
         ctx = self._context
         if ctx is not None:
-            ctx.executor.call_soon_threadsafe(partial(self._deliver, topic, data))
+            ctx.executor.run_now_or_soon(partial(self._deliver, topic, data))
 
     def _deliver(self, topic: Topic, data: bytes) -> None:
         try:
@@ -257,6 +273,30 @@ class Ros1Transport:
             if default is _MISSING:
                 raise KeyError(name) from None
             return default
+
+    def watch_param(self, node: Node, name: str, callback: Callable[[Any], None]) -> Any:
+        """Subscribe ``node`` to the master's parameter ``name`` (subscribeParam, as
+        roscpp's ``getParamCached``): ``callback(value)`` runs on the executor thread each
+        time someone sets it. Returns its value now (None when it is not set)."""
+        fq = node.get_fully_qualified_name()
+        uri = self.peer.add_node(fq)
+        key = name.rstrip("/")
+        self._watches.setdefault(fq, []).append((key, callback))
+        try:
+            value = call(self.master_uri, "subscribeParam", fq, uri, key, timeout_s=10.0)
+        except MasterError as err:
+            _log.warning("could not watch %s on %s: %s", key, self.master_uri, err)
+            return None
+        return None if value == {} else value  # the master answers {} for "not set"
+
+    def _on_param(self, node: str, key: str, value: Any) -> None:
+        """The master's paramUpdate to one of our nodes (a slave thread)."""
+        self.params.update(self._context, node, key, value)
+        ctx = self._context
+        changed = key.rstrip("/")
+        for watched, callback in self._watches.get(node, []):
+            if ctx is not None and changed == watched:
+                ctx.executor.call_soon_threadsafe(partial(callback, value))
 
     def set_param(self, name: str, value: Any) -> None:
         """Set a parameter on the master (as rospy.set_param does for a global name)."""
@@ -308,7 +348,7 @@ class Ros1Transport:
             finally:
                 done.set()
 
-        ctx.executor.call_soon_threadsafe(serve)
+        ctx.executor.run_now_or_soon(serve)
         if not done.wait(CALL_TIMEOUT_S):
             return (
                 False,

@@ -13,6 +13,7 @@ import http.client
 import os
 import socket
 import socketserver
+import time
 import xmlrpc.client
 from collections.abc import Callable
 from typing import Any
@@ -30,6 +31,7 @@ __all__ = [
     "parse_reply",
     "proxy",
     "split_uri",
+    "wait_for_master",
 ]
 
 MAX_BODY_BYTES = 64 << 20  # a /robot_description of a big robot is a few MB
@@ -158,3 +160,57 @@ def bind_host(advertise: str) -> str:
         return socket.gethostbyname(advertise)
     except OSError:
         return "0.0.0.0"
+
+
+#: How often a node retries an unreachable master (rospy: 0.2 s), and how often it says
+#: it is still waiting.
+MASTER_RETRY_S = 0.5
+MASTER_REMIND_S = 10.0
+
+
+def wait_for_master(
+    master_uri: str,
+    report: Callable[[str], None] | None,
+    *,
+    retry_s: float = MASTER_RETRY_S,
+    remind_s: float = MASTER_REMIND_S,
+) -> None:
+    """Return once the master at ``master_uri`` answers.
+
+    With ``report`` None (a one-shot tool, as rostopic) an unreachable master is an error
+    at once. Else (a node, as rospy's and roscpp's) it is asked again every ``retry_s``
+    until it answers: ``report`` gets one line at the first failure, one every
+    ``remind_s`` after, and one when the master answers.
+
+    Raises:
+        MasterError: no master answers and ``report`` is None.
+    """
+    start = time.monotonic()
+    remind = start + remind_s
+    waited = False
+    while True:
+        try:
+            call(master_uri, "getUri", "/roverlab", timeout_s=3.0)
+            if waited and report is not None:
+                report(f"reached the ROS master at {master_uri}")
+            return
+        except MasterError as err:
+            if report is None:
+                raise MasterError(
+                    f"no ROS master at {master_uri} ({err}); start one (roscore or "
+                    "roverlab roscore) or fix ROS_MASTER_URI"
+                ) from None
+            now = time.monotonic()
+            if not waited:
+                report(
+                    f"unable to register with the ROS master at {master_uri} ({err}): it may "
+                    f"not be running yet; trying again every {retry_s:g} s"
+                )
+                waited = True
+            elif now >= remind:
+                report(
+                    f"still no ROS master at {master_uri} after {now - start:.0f} s; "
+                    "still trying (start roscore, or fix ROS_MASTER_URI)"
+                )
+                remind = now + remind_s
+        time.sleep(retry_s)

@@ -29,9 +29,9 @@ import numba
 import numpy as np
 from numpy.typing import NDArray
 
-from roverlab.navigation.costmap.kernels import footprint_cost
+from roverlab.navigation.costmap.kernels import cells_cost, footprint_cells
 
-__all__ = ["rollout", "score_rollouts", "target_distance"]
+__all__ = ["first_known_stretch", "rollout", "score_rollouts", "target_distance"]
 
 _jit = numba.njit(cache=True, nogil=True)
 
@@ -100,6 +100,52 @@ def target_distance(
 
 
 @_jit
+def first_known_stretch(
+    plan: NDArray[np.float64],
+    costs: NDArray[np.uint8],
+    res: float,
+    ox: float,
+    oy: float,
+) -> NDArray[np.int64]:
+    """The cells ``(ix, iy)`` of ``plan`` (``(N, >= 2)``, its points first made no farther
+    apart than ``res`` as MapGrid's ``adjustPlanResolution``: ``a + j (b - a) / steps``)
+    from its first point on a known cell of the costmap ``costs`` (origin ``ox, oy``) up
+    to the point before the next one off the map or on unknown cost; ``(0, 2)`` when no
+    point is on a known cell."""
+    h, w = costs.shape
+    n = plan.shape[0]
+    total = 1
+    for i in range(n - 1):
+        d = math.hypot(plan[i + 1, 0] - plan[i, 0], plan[i + 1, 1] - plan[i, 1])
+        total += int(math.ceil(d / res)) if d > res else 1
+    out = np.empty((total, 2), dtype=np.int64)
+    m = 0
+    started = False
+    for i in range(n):
+        if i < n - 1:
+            ax, ay = plan[i, 0], plan[i, 1]
+            dx, dy = plan[i + 1, 0] - ax, plan[i + 1, 1] - ay
+            d = math.hypot(dx, dy)
+            steps = int(math.ceil(d / res)) if d > res else 1
+        else:
+            ax, ay, dx, dy, steps = plan[i, 0], plan[i, 1], 0.0, 0.0, 1
+        for j in range(steps):
+            px = ax + (j * dx) / steps
+            py = ay + (j * dy) / steps
+            cx = int(math.floor((px - ox) / res))
+            cy = int(math.floor((py - oy) / res))
+            ok = px >= ox and py >= oy and cx < w and cy < h and costs[cy, cx] != NO_INFO
+            if ok:
+                started = True
+                out[m, 0] = cx
+                out[m, 1] = cy
+                m += 1
+            elif started:
+                return out[:m]
+    return out[:m]
+
+
+@_jit
 def rollout(
     pos: NDArray[np.float64],
     vel: NDArray[np.float64],
@@ -115,8 +161,9 @@ def rollout(
     """SimpleTrajectoryGenerator's ``generateTrajectory`` for one velocity sample.
 
     Writes the poses (from the current pose, ``num_steps`` of them) to ``out``, followed by
-    the poses of ``extra_time`` more seconds at the same velocity. Returns
-    ``(num_steps, extra_steps, dt)``; ``num_steps`` 0 if the sample gives no trajectory.
+    the poses of ``extra_time`` more seconds at the same velocity (with five columns, each
+    pose's ``cos(th)`` and ``sin(th)`` too). Returns ``(num_steps, extra_steps, dt)``;
+    ``num_steps`` 0 if the sample gives no trajectory.
     """
     vmag = math.hypot(target[0], target[1])
     num = int(
@@ -143,14 +190,24 @@ def rollout(
     vth = target[2]
     if continued_acceleration:
         vx, vy, vth = _accelerate(target, vel[0], vel[1], vel[2], acc, dt)
+    trig = out.shape[1] >= 5
     for i in range(num + extra):
+        c = math.cos(th)
+        s = math.sin(th)
         out[i, 0] = x
         out[i, 1] = y
         out[i, 2] = th
+        if trig:
+            out[i, 3] = c
+            out[i, 4] = s
         if continued_acceleration and i < num:
             vx, vy, vth = _accelerate(target, vx, vy, vth, acc, dt)
-        x += (vx * math.cos(th) + vy * math.cos(math.pi / 2 + th)) * dt
-        y += (vx * math.sin(th) + vy * math.sin(math.pi / 2 + th)) * dt
+        if vy != 0.0:
+            x += (vx * c + vy * math.cos(math.pi / 2 + th)) * dt
+            y += (vx * s + vy * math.sin(math.pi / 2 + th)) * dt
+        else:  # the same values (a zero's sign aside, which nothing reads)
+            x += vx * c * dt
+            y += vx * s * dt
         th += vth * dt
     return num, extra, dt
 
@@ -175,17 +232,98 @@ def _accelerate(
 
 
 @_jit
-def _grid_value(
-    grid: NDArray[np.float64], res: float, ox: float, oy: float, x: float, y: float
-) -> float:
-    h, w = grid.shape
+def _cell(w: int, h: int, res: float, ox: float, oy: float, x: float, y: float) -> tuple[int, int]:
+    """The map cell of ``(x, y)``; ``(-1, -1)`` off the map."""
     if x < ox or y < oy:
-        return -1.0
+        return -1, -1
     mx = int((x - ox) / res)
     my = int((y - oy) / res)
     if mx >= w or my >= h:
-        return -1.0
-    return grid[my, mx]
+        return -1, -1
+    return mx, my
+
+
+@_jit
+def _grid_critics(
+    traj: NDArray[np.float64],
+    num: int,
+    res: float,
+    ox: float,
+    oy: float,
+    size: float,
+    path_grid: NDArray[np.float64],
+    goal_grid: NDArray[np.float64],
+    front_grid: NDArray[np.float64],
+    scales: NDArray[np.float64],
+) -> tuple[float, float]:
+    """Critics 3-6 of the module docstring over the first ``num`` poses of ``traj`` (x, y,
+    th, cos th, sin th): ``(failure, cost)``, the failure (< 0) of the first critic that
+    fails, else 0 and the critics' weighted sum.
+
+    Each critic, as MapGridCostFunction, visits every point and stops at its first
+    failure: the two at ``forward_point_distance`` ahead (goal front, alignment) read
+    different grids at the same points and fail only off the map, so one pass serves
+    both; path and goal share the centres, and the path critic's failure, coming first,
+    wins over the goal critic's at any point.
+    """
+    h, w = path_grid.shape
+    front_s, align_s, path_s, goal_s, fpd = scales[1], scales[2], scales[3], scales[4], scales[6]
+    front_v = 0.0
+    align_v = 0.0
+    if front_s != 0.0 or align_s != 0.0:
+        mx = -1
+        my = -1
+        for i in range(num):
+            px = traj[i, 0] + fpd * traj[i, 3]
+            py = traj[i, 1] + fpd * traj[i, 4]
+            mx, my = _cell(w, h, res, ox, oy, px, py)
+            if mx < 0:
+                return -4.0, 0.0
+        front_v = front_grid[my, mx]
+        align_v = path_grid[my, mx]
+    path_v = 0.0
+    goal_v = 0.0
+    on_path = path_s != 0.0
+    on_goal = goal_s != 0.0
+    if on_path or on_goal:
+        goal_fail = 0.0
+        mx = -1
+        my = -1
+        for i in range(num):
+            mx, my = _cell(w, h, res, ox, oy, traj[i, 0], traj[i, 1])
+            if mx < 0:
+                if on_path:
+                    return -4.0, 0.0
+                goal_fail = -4.0
+                break
+            if on_path:
+                v = path_grid[my, mx]
+                if v == size:
+                    return -3.0, 0.0
+                if v == size + 1.0:
+                    return -2.0, 0.0
+            if on_goal and goal_fail == 0.0:
+                v = goal_grid[my, mx]
+                if v == size:
+                    goal_fail = -3.0
+                elif v == size + 1.0:
+                    goal_fail = -2.0
+                if goal_fail < 0.0 and not on_path:
+                    break
+        if goal_fail < 0.0:
+            return goal_fail, 0.0
+        path_v = path_grid[my, mx]
+        goal_v = goal_grid[my, mx]
+    total = 0.0
+    if front_s != 0.0 and front_v != 0.0:
+        total += front_v * front_s
+    if align_s != 0.0 and align_v != 0.0:
+        total += align_v * align_s
+    if on_path and path_v != 0.0:
+        total += path_v * path_s
+    if on_goal and goal_v != 0.0:
+        total += goal_v * goal_s
+    return 0.0, total
 
 
 @_jit
@@ -203,6 +341,16 @@ def _rollout_cap(vx: float, vy: float, vth: float, gen: NDArray[np.float64]) -> 
     num = int(math.ceil(max(vmag * gen[0] / gen[1], abs(vth) * gen[0] / gen[2])))
     dt = gen[0] / max(num, 1)
     return num + int(math.ceil(gen[6] / dt)) + 4
+
+
+@_jit
+def _same_rows(a: NDArray[np.int64], b: NDArray[np.int64], n: int) -> bool:
+    same = True
+    for i in range(n):
+        if a[i, 0] != b[i, 0] or a[i, 1] != b[i, 1]:
+            same = False
+            break
+    return same
 
 
 @_jit
@@ -233,9 +381,10 @@ def score_rollouts(
 
     The grid critics and the cheap rejections are computed for every sample first; with
     ``prune`` the obstacle critic then runs in increasing order of that partial cost and
-    is skipped for samples whose partial cost already exceeds the best total (their
-    ``out`` is that partial cost, a lower bound): the choice is the same as scoring every
-    critic of every sample, as SimpleScoredSamplingPlanner's early break.
+    is skipped for samples whose partial cost already exceeds the best total, or stopped
+    along a trajectory as soon as the cost so far exceeds it (their ``out`` is that cost
+    so far, a lower bound): the choice is the same as scoring every critic of every
+    sample, as SimpleScoredSamplingPlanner's early break.
 
     Args:
         samples: ``(K, 3)`` target velocities ``vx, vy, vth``.
@@ -259,12 +408,10 @@ def score_rollouts(
     """
     h, w = costs.shape
     size = float(h * w)
-    front_s, align_s, path_s, goal_s, twirl_s, fpd = (
-        scales[1], scales[2], scales[3], scales[4], scales[5], scales[6],
-    )  # fmt: skip
+    twirl_s = scales[5]
     occ_s = scales[0]
     nk = samples.shape[0]
-    traj = np.empty((8, 3))
+    traj = np.empty((8, 5))
     buf = np.empty((w + h + 4, 2), dtype=np.int64)
     partial = np.empty(nk)
     for k in range(nk):
@@ -276,7 +423,7 @@ def score_rollouts(
             continue
         need = _rollout_cap(vx, vy, vth, gen)
         if traj.shape[0] < need:
-            traj = np.empty((need, 3))
+            traj = np.empty((need, 5))
         num, _extra, _dt = rollout(
             pos, vel, samples[k], gen[0], gen[1], gen[2], continued_acceleration, acc, 0.0, traj
         )
@@ -292,37 +439,9 @@ def score_rollouts(
         if (flags[4] and vth < 0.0) or (flags[5] and vth > 0.0):
             out[k] = -6.0
             continue
-        total = 0.0
-        failed = 0.0
-        for critic in range(4):
-            if critic == 0:
-                sc, grid, shift, strict = front_s, front_grid, fpd, False
-            elif critic == 1:
-                sc, grid, shift, strict = align_s, path_grid, fpd, False
-            elif critic == 2:
-                sc, grid, shift, strict = path_s, path_grid, 0.0, True
-            else:
-                sc, grid, shift, strict = goal_s, goal_grid, 0.0, True
-            if sc == 0.0:
-                continue
-            v = 0.0
-            for i in range(num):
-                px = traj[i, 0] + shift * math.cos(traj[i, 2])
-                py = traj[i, 1] + shift * math.sin(traj[i, 2])
-                v = _grid_value(grid, res, ox, oy, px, py)
-                if v < 0:
-                    failed = -4.0
-                    break
-                if strict and v == size:
-                    failed = -3.0
-                    break
-                if strict and v == size + 1.0:
-                    failed = -2.0
-                    break
-            if failed < 0:
-                break
-            if v != 0.0:
-                total += v * sc
+        failed, total = _grid_critics(
+            traj, num, res, ox, oy, size, path_grid, goal_grid, front_grid, scales
+        )
         if failed < 0:
             out[k] = failed
             continue
@@ -337,6 +456,9 @@ def score_rollouts(
                 best = k
         return best
     order = np.argsort(np.where(out >= 0, out, np.inf), kind="mergesort")
+    ncells = fp.shape[0] + 1 if fp.shape[0] >= 3 else 1
+    cells = np.empty((fp.shape[0] + 1, 2), dtype=np.int64)
+    last = np.empty_like(cells)
     best = -1
     best_cost = np.inf
     for q in range(nk):
@@ -349,7 +471,7 @@ def score_rollouts(
         vy = samples[k, 1]
         need = _rollout_cap(vx, vy, samples[k, 2], gen)
         if traj.shape[0] < need:
-            traj = np.empty((need, 3))
+            traj = np.empty((need, 5))
         num, extra, _dt = rollout(
             pos, vel, samples[k], gen[0], gen[1], gen[2], continued_acceleration, acc, gen[6],
             traj,
@@ -360,19 +482,36 @@ def score_rollouts(
             scale = scaling[2] * (vmag - scaling[0]) / (scaling[1] - scaling[0]) + 1.0
         oc = 0.0
         bad = 0.0
+        known = False
+        fc = 0.0
+        beaten = False
         for i in range(num + extra):
-            fc = footprint_cost(
-                costs, res, ox, oy, traj[i, 0], traj[i, 1], traj[i, 2], fp, scale, buf
-            )
+            # footprint_cost, reusing the last pose's cost when the centre and vertex
+            # cells are the same (the cost is a function of those cells)
+            if not footprint_cells(
+                w, h, res, ox, oy, traj[i, 0], traj[i, 1], traj[i, 3], traj[i, 4], fp, scale,
+                cells,
+            ):  # fmt: skip
+                bad = -6.0
+                break
+            if not (known and _same_rows(cells, last, ncells)):
+                fc = cells_cost(costs, cells, fp.shape[0], buf)
+                last[:ncells] = cells[:ncells]
+                known = True
             if fc < 0:
                 bad = fc
                 break
             if i < num:
                 oc = oc + fc if sum_scores else max(oc, fc)
+                if prune and partial[k] + oc * occ_s > best_cost:
+                    beaten = True  # the cost only grows from here: this sample cannot win
+                    break
         if bad < 0:
             out[k] = bad
             continue
         out[k] = partial[k] + oc * occ_s
+        if beaten:
+            continue  # out[k]: a lower bound, above the best
         if out[k] < best_cost or (out[k] == best_cost and k < best):
             best_cost = out[k]
             best = k

@@ -48,12 +48,16 @@ from roverlab.navigation.controllers.base import (
     prune_plan,
     stopped,
 )
-from roverlab.navigation.controllers.dwa.kernels import rollout, score_rollouts, target_distance
+from roverlab.navigation.controllers.dwa.kernels import (
+    first_known_stretch,
+    rollout,
+    score_rollouts,
+    target_distance,
+)
 from roverlab.navigation.controllers.dwa.params import DWAParams
 from roverlab.navigation.costmap.costmap_2d import (
     INSCRIBED_INFLATED_OBSTACLE,
     LETHAL_OBSTACLE,
-    NO_INFORMATION,
     Costmap2D,
 )
 from roverlab.navigation.costmap.kernels import footprint_cost, outline_cells
@@ -105,24 +109,10 @@ def _first_known_stretch(plan: NDArray[np.float64], cm: Costmap2D) -> NDArray[np
     :func:`_adjust_resolution`) from its first point on a known cell of ``cm`` up to the
     point before the next one that is off the map or on unknown cost; None when no point
     is on a known cell."""
-    res = cm.resolution
-    adjusted = _adjust_resolution(plan, res)
-    cells = np.floor((adjusted - [cm.origin_x, cm.origin_y]) / res).astype(np.int64)
-    inside = (
-        (adjusted[:, 0] >= cm.origin_x)
-        & (adjusted[:, 1] >= cm.origin_y)
-        & (cells[:, 0] < cm.size_x)
-        & (cells[:, 1] < cm.size_y)
-    )
-    ok = inside.copy()
-    ok[inside] = cm.costs[cells[inside, 1], cells[inside, 0]] != NO_INFORMATION
-    idx = np.nonzero(ok)[0]
-    if len(idx) == 0:
-        return None
-    first = idx[0]
-    stop = np.nonzero(~ok[first:])[0]
-    end = len(ok) if len(stop) == 0 else first + int(stop[0])
-    return cells[first:end]
+    cells = first_known_stretch(
+        np.ascontiguousarray(plan[:, :2]), cm.costs, cm.resolution, cm.origin_x, cm.origin_y
+    )  # compiled; the same cells as adjusting the plan and looking each point up
+    return cells if len(cells) else None
 
 
 class DWAPlanner:
@@ -246,7 +236,9 @@ class DWAPlanner:
         front[-1, 0] += p.forward_point_distance * math.cos(ang)
         front[-1, 1] += p.forward_point_distance * math.sin(ang)
         front_stretch = _first_known_stretch(front, cm)
-        if front_stretch is not None:
+        if front_stretch is not None and (front_stretch[-1] == stretch[-1]).all():
+            front_grid[:] = goal_grid  # the same seed (the plan leaves the map before its end)
+        elif front_stretch is not None:
             target_distance(cm.costs, np.ascontiguousarray(front_stretch[-1:]), front_grid)
         else:
             front_grid[:] = cm.size_x * cm.size_y + 1

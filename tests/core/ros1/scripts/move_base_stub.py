@@ -1,0 +1,28 @@
+"""A real actionlib move_base_msgs/MoveBase server (run by /usr/bin/python3 with Debian's
+rospy and actionlib) standing in for move_base: each goal gets one feedback (the goal's
+own pose) and succeeds, or is aborted when its x is negative; one line per goal on
+stdout (``goal FRAME X Y``). Prints ``ready`` once it serves."""
+
+import rospy
+from move_base_msgs.msg import MoveBaseAction, MoveBaseFeedback, MoveBaseResult
+
+import actionlib
+
+rospy.init_node("move_base", anonymous=False)
+
+
+def execute(goal):
+    pose = goal.target_pose
+    x, y = pose.pose.position.x, pose.pose.position.y
+    print(f"goal {pose.header.frame_id} {x:.2f} {y:.2f}", flush=True)
+    server.publish_feedback(MoveBaseFeedback(base_position=pose))
+    if pose.pose.position.x < 0:
+        server.set_aborted(MoveBaseResult(), "negative x")
+    else:
+        server.set_succeeded(MoveBaseResult())
+
+
+server = actionlib.SimpleActionServer("move_base", MoveBaseAction, execute, auto_start=False)
+server.start()
+print("ready", flush=True)
+rospy.spin()
