@@ -200,3 +200,25 @@ def test_trajectory_planner_ros_escape_and_deprecated_names() -> None:
     assert old.escape_vel == -0.2 and any("backup_vel has been renamed" in w for w in warnings)
     with pytest.raises(NavigationParamsError, match="escape_vel must be <= 0"):
         DWAParams.from_trajectory_planner_ros({"escape_vel": 0.5})
+
+
+def test_trajectory_planner_checks_a_trajectory_up_to_sim_time_only() -> None:
+    """TrajectoryPlanner's stop_time_buffer check is commented out in ROS: BARN's 0.5 m/s
+    for 2 s ends 0.98 m ahead (its last pose), and a wall 0.05 m beyond the padded front
+    there must not refuse it (DWA's 0.2 s more refused it: the robot crawled)."""
+    p, _ = DWAParams.from_trajectory_planner_ros(
+        {"max_vel_x": 0.5, "min_vel_x": 0.1, "sim_time": 2.0, "sim_granularity": 0.02,
+         "acc_lim_x": 10.0, "holonomic_robot": False, "dwa": True}
+    )  # fmt: skip
+    fp = [[-0.31, -0.265], [-0.31, 0.265], [0.31, 0.265], [0.31, -0.265]]
+    dwa = DWAPlanner(p, footprint=fp)
+    cm = Costmap2D(size_x=100, size_y=100, resolution=0.05)
+    pose = SE2(1.0, 2.5, 0.0)
+    cm.costs[40:60, int((1.0 + 0.98 + 0.31 + 0.05) / 0.05)] = 254  # x 2.30-2.35, y 2-3 m
+    plan = np.array([[1.0, 2.5, 0.0], [4.0, 2.5, 0.0]])
+    dwa.set_plan(plan)
+    dwa._update_local_costs(pose, plan, cm)
+    fast = np.array([[0.5, 0.0, 0.0]])
+    vel = Velocity2D(0.5, 0.0, 0.0)
+    assert dwa._score(pose, vel, fast, cm, dwa._only)[1][0] >= 0
+    assert dwa.compute_velocity(pose, vel, plan, cm).vx == pytest.approx(0.5)

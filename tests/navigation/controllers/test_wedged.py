@@ -93,7 +93,8 @@ def test_an_escape_blocked_behind_gives_forward_motion_back() -> None:
     behind the body), forward motion is sampled again rather than refusing everything."""
     cm = Costmap2D(size_x=80, size_y=80, resolution=RES)
     pose = SE2(1.0, 2.0, 0.0)
-    cm.costs[30:50, int((pose.x - 0.27) / RES)] = 254  # cell 0.70-0.75 m: 4 cm behind
+    # cell 0.65-0.70 m: 9 cm behind the body, inside the padding, clear of half of it
+    cm.costs[30:50, int((pose.x - 0.33) / RES)] = 254
     plan = np.array([[1.0, 2.0, 0.0], [2.0, 2.0, 0.0], [3.5, 2.0, 0.0]])
     dwa = _dwa(-0.5)
     dwa.escaping, dwa._escape_from = True, pose  # backing out of a wedge, just begun

@@ -70,9 +70,11 @@ _TP_DEFAULTS: dict[str, Any] = {
     "simple_attractor": False,
     "world_model": "costmap",
 }
-# read by TrajectoryPlanner only with heading_scoring (warned when true), or visualisation;
+# read by TrajectoryPlanner only with heading_scoring (warned when true), or never used
+# (stop_time_buffer: its check is commented out), or visualisation;
 # min_vel_theta is not one of TrajectoryPlannerROS's parameters (min_in_place_vel_theta is)
 _TP_IGNORED = (
+    "stop_time_buffer",
     "heading_lookahead",
     "heading_scoring_timestep",
     "publish_cost_grid_pc",
@@ -321,6 +323,10 @@ class DWAParams:
             "escape_vel": v["escape_vel"],
             "escape_reset_dist": v["escape_reset_dist"],
             "escape_reset_theta": v["escape_reset_theta"],
+            # TrajectoryPlannerROS reads stop_time_buffer, but the check that used it is
+            # commented out in TrajectoryPlanner::generateTrajectory: a trajectory is
+            # checked up to sim_time and no further
+            "stop_time_buffer": 0.0,
         }
         for name, key in (
             ("path_distance_bias", "pdist_scale"),

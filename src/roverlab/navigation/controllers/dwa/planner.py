@@ -20,11 +20,13 @@ When every sample is refused, base_local_planner's escape (TrajectoryPlanner's
 the robot backs up at ``escape_vel`` and forward samples are left out until it has moved
 ``escape_reset_dist`` or turned ``escape_reset_theta`` from where the escape began. ROS
 backs up blind ("even when the static map shows it as blocked"); roverlab backs up only
-while the robot's real (unpadded) footprint stays clear of lethal cells, which is what
-frees a robot whose *padded* footprint touches an obstacle its body clears. Before that,
-when the padded footprint is refused where the robot stands but its body is clear, the
-samples are scored with the body's footprint and the cheapest whose last pose is clear
-with the padded one is taken; once backing up is blocked too, forward samples return.
+while the robot's body stays clear of lethal cells, which is what frees a robot whose
+*padded* footprint touches an obstacle its body clears. Before that, when the padded
+footprint is refused where the robot stands but its body is clear, the samples are
+scored with the body's footprint and the cheapest whose last pose is clear with the
+padded one is taken; once backing up is blocked too, forward samples return. The body
+there is the ``footprint`` parameter with half the padding kept (it may leave out the
+wheels, as BARN's Jackal footprint does), or the bare one when that finds no way out.
 
 Failures raise :class:`NoValidControlError` (the robot must stop) or
 :class:`InvalidPathError`.
@@ -484,31 +486,45 @@ class DWAPlanner:
     ) -> tuple[int, NDArray[np.float64]]:  # fmt: skip
         """When the padded footprint is refused where the robot stands but its body is
         clear (an obstacle inside the padding): the samples scored with the body's
-        footprint, the cheapest one taken whose last pose is clear with the padded one."""
-        body, fp = self.body_footprint, self.footprint
-        if len(body) < 3 or (body.shape == fp.shape and np.array_equal(body, fp)):
-            return -1, costs
+        footprint, the cheapest one taken whose last pose is clear with the padded one;
+        with each of :meth:`_escape_footprints` in turn that is clear where the robot
+        stands, until one gives a sample."""
+        fp = self.footprint
         p = self.params
         args = (cm.resolution, cm.origin_x, cm.origin_y)
         line = np.empty((cm.size_x + cm.size_y + 4, 2), dtype=np.int64)
-        if footprint_cost(cm.costs, *args, pose.x, pose.y, pose.theta, body, 1.0, line) < 0:
-            return -1, costs
-        best, bcosts = self._score(pose, vel, samples, cm, self._only, prune=False, footprint=body)
-        if best < 0:
-            return -1, costs
         acc = np.array([p.acc_lim_x, p.acc_lim_y, p.acc_lim_theta])
         traj = np.empty((int(p.sim_time / min(p.sim_granularity, 1.0)) * 4 + 64, 3))
-        for k in np.argsort(np.where(bcosts >= 0, bcosts, np.inf), kind="stable"):
-            if bcosts[k] < 0:
-                break
-            num, _, _ = rollout(
-                pose.as_array(), vel.as_array(), samples[k], p.sim_time, p.sim_granularity,
-                p.angular_sim_granularity, not p.use_dwa, acc, 0.0, traj,
-            )  # fmt: skip
-            x, y, th = (float(v) for v in traj[max(num - 1, 0)])
-            if num and footprint_cost(cm.costs, *args, x, y, th, fp, 1.0, line) >= 0:
-                return int(k), bcosts
+        for body in self._escape_footprints():
+            if len(body) < 3 or (body.shape == fp.shape and np.array_equal(body, fp)):
+                return -1, costs
+            if footprint_cost(cm.costs, *args, pose.x, pose.y, pose.theta, body, 1.0, line) < 0:
+                continue
+            _, bcosts = self._score(pose, vel, samples, cm, self._only, prune=False, footprint=body)
+            for k in np.argsort(np.where(bcosts >= 0, bcosts, np.inf), kind="stable"):
+                if bcosts[k] < 0:
+                    break
+                num, _, _ = rollout(
+                    pose.as_array(), vel.as_array(), samples[k], p.sim_time, p.sim_granularity,
+                    p.angular_sim_granularity, not p.use_dwa, acc, 0.0, traj,
+                )  # fmt: skip
+                x, y, th = (float(v) for v in traj[max(num - 1, 0)])
+                if num and footprint_cost(cm.costs, *args, x, y, th, fp, 1.0, line) >= 0:
+                    return int(k), bcosts
         return -1, costs
+
+    def _escape_footprints(self) -> list[NDArray[np.float64]]:
+        """The body's footprints the ways out check, in order: the ``footprint``
+        parameter with half the costmap's padding kept (padFootprint moves each vertex
+        outwards, so the half-way polygon is the vertices' mean), then the bare
+        ``footprint`` when that one finds no way out. The parameter
+        may leave out what the padding covers: BARN's Jackal footprint is its 0.33 m
+        chassis, its wheels reach 0.42 m, and a robot turning past a pillar on the bare
+        chassis touched it with a wheel."""
+        body, fp = self.body_footprint, self.footprint
+        if body.shape != fp.shape or np.array_equal(body, fp):
+            return [body]
+        return [np.ascontiguousarray((body + fp) / 2.0), body]
 
     def _update_escape(self, pose: SE2) -> None:
         """The escape ends once the robot is ``escape_reset_dist`` away from, or
@@ -525,7 +541,8 @@ class DWAPlanner:
     def _back_up(self, pose: SE2, twist: Velocity2D, cm: Costmap2D) -> Velocity2D | None:
         """TrajectoryPlanner's last resort: straight back at ``escape_vel`` (acceleration
         limited), if the real footprint stays clear of lethal and unknown cells for
-        ``escape_reset_dist`` (or the whole ``sim_time`` if that is shorter); None
+        ``escape_reset_dist`` (or the whole ``sim_time`` if that is shorter; the first
+        of :meth:`_escape_footprints` that does); None
         otherwise (or with ``escape_vel`` 0)."""
         p = self.params
         if p.escape_vel >= 0.0:
@@ -539,20 +556,33 @@ class DWAPlanner:
         )  # fmt: skip
         need = min(p.escape_reset_dist, abs(p.escape_vel) * p.sim_time)
         line = np.empty((cm.size_x + cm.size_y + 4, 2), dtype=np.int64)
-        for x, y, th in traj[:num]:
-            if footprint_cost(
-                cm.costs, cm.resolution, cm.origin_x, cm.origin_y, float(x), float(y),
-                float(th), self.body_footprint, 1.0, line,
-            ) < 0:  # fmt: skip
-                return None
-            if math.hypot(x - pose.x, y - pose.y) >= need:
+        for body in self._escape_footprints():
+            if self._clear_backing(pose, traj[:num], need, body, cm, line):
                 break
+        else:
+            return None
         if not self.escaping:
             self.escaping = True
             self._escape_from = pose
         self.trajectory = traj[:num].copy()
         vx = max(p.escape_vel, twist.vx - p.acc_lim_x * p.sim_period)
         return Velocity2D(vx, 0.0, 0.0)
+
+    @staticmethod
+    def _clear_backing(
+        pose: SE2, traj: NDArray[np.float64], need: float, body: NDArray[np.float64],
+        cm: Costmap2D, line: NDArray[np.int64],
+    ) -> bool:  # fmt: skip
+        """Whether ``body`` stays clear along ``traj`` until ``need`` m from ``pose``."""
+        for x, y, th in traj:
+            if footprint_cost(
+                cm.costs, cm.resolution, cm.origin_x, cm.origin_y, float(x), float(y),
+                float(th), body, 1.0, line,
+            ) < 0:  # fmt: skip
+                return False
+            if math.hypot(x - pose.x, y - pose.y) >= need:
+                break
+        return True
 
     def _stop_rotate(self, pose: SE2, twist: Velocity2D, cm: Costmap2D) -> Velocity2D:
         """LatchedStopRotateController::computeVelocityCommandsStopRotate."""
