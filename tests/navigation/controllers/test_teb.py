@@ -270,3 +270,63 @@ def test_jackal_band_pushes_out_a_post_that_appears_inside_it() -> None:
     assert not inside.any(), poses[inside]
     length = float(np.sum(np.hypot(*np.diff(poses[:, :2], axis=0).T)))
     assert len(poses) < 40 and length < 5.0, (len(poses), length)
+
+
+def test_failure_detector_flags_a_robot_turning_back_and_forth() -> None:
+    """TEB's FailureDetector: normalised commands, detection from half a buffer, mean
+    speeds below the eps and more than one sign change of the angular velocity."""
+    from roverlab.navigation.controllers.teb.recovery import FailureDetector
+
+    fd = FailureDetector(10)
+    wobble = [Velocity2D(0.01, 0.0, 0.3 * (-1) ** k) for k in range(10)]
+    assert not fd.update(wobble[0], 0.5, 0.2, 1.5, 0.1, 0.1)  # less than half full
+    results = [fd.update(c, 0.5, 0.2, 1.5, 0.1, 0.1) for c in wobble[1:]]
+    assert results[3:] == [True] * 6  # from 5 of 10 entries on
+    turning = FailureDetector(10)
+    assert not any(turning.update(Velocity2D(0.0, 0.0, 0.3), 0.5, 0.2, 1.5, 0.1, 0.1)
+                   for _ in range(10))  # fmt: skip
+    driving = FailureDetector(10)
+    assert not any(driving.update(Velocity2D(0.3, 0.0, 0.3 * (-1) ** k), 0.5, 0.2, 1.5, 0.1, 0.1)
+                   for k in range(10))  # fmt: skip
+
+
+def test_oscillation_recovery_prefers_the_current_turning_direction() -> None:
+    """TebLocalPlannerROS::configureBackupModes: on an oscillation the robot's current
+    turning direction is kept (EdgePreferRotDir on the band's first three turns) for
+    oscillation_recovery_min_duration s, then released. The turn the band plans for a goal
+    straight behind the robot follows it."""
+    from roverlab.navigation.controllers.teb.recovery import OscillationRecovery
+    from roverlab.navigation.move_base.plugins import make_local_planner
+
+    teb, _, _ = make_local_planner(
+        "teb_local_planner/TebLocalPlannerROS",
+        {**TEB, "oscillation_filter_duration": 1.0, "oscillation_recovery_min_duration": 2.0},
+        footprint=FOOT,
+        controller_frequency=10.0,
+    )
+    params = teb.params  # type: ignore[attr-defined]
+    assert params.controller_frequency == 10.0  # move_base's, as TEB reads it
+    rec = OscillationRecovery(params)
+    t = 0.0
+    for k in range(10):  # 1 s of a wobble, the robot turning right at the end
+        out = rec.update(t, Velocity2D(0.0, 0.0, 0.2 * (-1) ** k), Velocity2D(0.0, 0.0, -0.1))
+        t += 0.1
+    assert out == -1
+    steady = Velocity2D(0.3, 0.0, 0.0)
+    held = []
+    while t < 5.0:
+        held.append(rec.update(t, steady, Velocity2D(0.3, 0.0, 0.0)))
+        t += 0.1
+    assert held[0] == -1 and held[-1] == 0  # held for 2 s after the last detection
+    assert 15 <= held.count(-1) <= 25
+    # a goal straight behind: the band turns right; preferring left holds its first three
+    # turns (TEB's EdgePreferRotDir penalises only the other direction) and the command
+    plan = np.column_stack([np.linspace(1.5, 0.5, 11), np.full(11, 1.5), np.full(11, math.pi)])
+    wz, first = {}, {}
+    for rotdir in (1, -1):
+        p = TebPlanner(params, footprint=FOOT)
+        p._recovery.preferred_rotdir, p._recovery.time_last_oscillation = rotdir, 0.0
+        wz[rotdir] = p.compute_velocity(SE2(1.5, 1.5, 0.0), Velocity2D(), plan, _open()).wz
+        first[rotdir] = p.band.poses[3, 2]
+    assert wz[-1] < -0.5 and first[-1] < -0.5
+    assert wz[1] > -0.2 and first[1] > -0.1, (wz, first)
