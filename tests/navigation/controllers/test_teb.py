@@ -12,7 +12,7 @@ from roverlab.geometry import SE2
 from roverlab.navigation.controllers import FootprintModel, TebParams, TebPlanner, Velocity2D
 from roverlab.navigation.controllers.teb import TimedElasticBand
 from roverlab.navigation.controllers.teb.kernels import associate_obstacles, robot_distance
-from roverlab.navigation.costmap import Costmap2D, footprint_from_radius
+from roverlab.navigation.costmap import Costmap2D, footprint_from_radius, pad_footprint
 from roverlab.navigation.errors import NavigationParamsError, NoValidControlError
 from roverlab.navigation.planners import NavfnPlanner
 from tests.navigation.controllers.conftest import TEB
@@ -215,21 +215,118 @@ def test_feasibility_check_lookahead_distance_replaces_the_pose_count() -> None:
     assert not feasible(feasibility_check_no_poses=2, feasibility_check_lookahead_distance=2.0)
 
 
-def test_jackal_teb_model_is_the_padded_costmap_footprint() -> None:
-    """The bundled Jackal file's footprint_model is the costmap's padded footprint (BARN's
-    0.42 x 0.33 m body + footprint_padding 0.1): TEB checks feasibility with the costmap's
-    footprint, so a bare-body model let the band come within the padding of the posts and
-    every BARN world with a tight passage ended in "trajectory is not feasible" at 2 m/s."""
+def _jackal() -> TebParams:
     import yaml
 
     from roverlab.description import find_package
-    from roverlab.navigation.costmap import pad_footprint
 
     path = find_package("robot_navigation") / "param" / "Jackal" / "teb_local_planner_params.yaml"
-    params, _ = TebParams.from_ros(yaml.safe_load(path.read_text())["TebLocalPlannerROS"])
-    body = [[-0.21, -0.165], [-0.21, 0.165], [0.21, 0.165], [0.21, -0.165]]
-    assert params.footprint_model.type == "polygon"
-    model = params.footprint_model.as_array().reshape(-1, 2)
-    np.testing.assert_allclose(model, pad_footprint(body, 0.1))
+    return TebParams.from_ros(yaml.safe_load(path.read_text())["TebLocalPlannerROS"])[0]
+
+
+_BODY = np.array([[-0.21, -0.165], [-0.21, 0.165], [0.21, 0.165], [0.21, -0.165]])
+
+
+def test_jackal_teb_model_covers_the_padded_footprint_inside_and_out() -> None:
+    """The bundled Jackal file's model keeps every point of the costmap's padded footprint
+    (BARN's 0.42 x 0.33 m body + footprint_padding 0.1) within min_obstacle_dist, the
+    centre included. TEB checks feasibility with the padded footprint, so a bare-body model
+    let the band come within the padding (2 m/s: "not feasible" near every post); and TEB's
+    polygon distance is to the outline, so the padded polygon itself (the old file) put
+    its centre 0.265 m from "the robot": a post inside a pose was never pushed out."""
+    params = _jackal()
+    fm = params.footprint_model
+    padded = pad_footprint(_BODY, 0.1)
+    lo, hi = padded.min(axis=0), padded.max(axis=0)
+    gx, gy = np.meshgrid(np.linspace(lo[0], hi[0], 13), np.linspace(lo[1], hi[1], 11))
+    dist = [robot_distance(0.0, 0.0, 0.0, fm.code, fm.as_array(), x, y)
+            for x, y in zip(gx.ravel(), gy.ravel(), strict=True)]  # fmt: skip
+    assert max(dist) < params.min_obstacle_dist
     # at 2 m/s feasibility_check_no_poses 5 reaches 3 m ahead; the file checks 1 m
     assert params.feasibility_check_lookahead_distance == 1.0
+
+
+def test_jackal_band_pushes_out_a_post_that_appears_inside_it() -> None:
+    """BARN world_194 at 0.5 m/s: a post the laser first marks where the warm-started band
+    already runs lies inside some poses' footprints. With the old file (the padded polygon,
+    whose distance is to the outline) those poses kept the post inside, the band between
+    them tangled and autoResize grew it to 500 poses (150-600 ms per cycle). The band must
+    leave the post outside every pose and stay short."""
+    params = _jackal()
+    teb = TebPlanner(params, footprint=pad_footprint(_BODY, 0.1))
+    cm = Costmap2D(size_x=100, size_y=100, resolution=0.05)  # 5 x 5 m
+    plan = np.column_stack([np.linspace(0.5, 4.0, 36), np.full(36, 2.5), np.zeros(36)])
+    start = SE2(0.5, 2.5, 0.0)
+    teb.compute_velocity(start, Velocity2D(), plan, cm)  # the straight band, warm
+    cm.costs[49:52, 44:47] = 254  # a 0.15 m post at (2.25, 2.5), 1.75 m ahead, on the band
+    post = np.array([2.25, 2.5])
+    for _ in range(8):
+        teb.compute_velocity(start, Velocity2D(), plan, cm)
+    poses = teb.band.poses
+    rel = post - poses[:, :2]
+    c, s = np.cos(poses[:, 2]), np.sin(poses[:, 2])
+    along, across = rel[:, 0] * c + rel[:, 1] * s, -rel[:, 0] * s + rel[:, 1] * c
+    inside = (np.abs(along) < 0.21 + 0.075) & (np.abs(across) < 0.165 + 0.075)
+    assert not inside.any(), poses[inside]
+    length = float(np.sum(np.hypot(*np.diff(poses[:, :2], axis=0).T)))
+    assert len(poses) < 40 and length < 5.0, (len(poses), length)
+
+
+def test_failure_detector_flags_a_robot_turning_back_and_forth() -> None:
+    """TEB's FailureDetector: normalised commands, detection from half a buffer, mean
+    speeds below the eps and more than one sign change of the angular velocity."""
+    from roverlab.navigation.controllers.teb.recovery import FailureDetector
+
+    fd = FailureDetector(10)
+    wobble = [Velocity2D(0.01, 0.0, 0.3 * (-1) ** k) for k in range(10)]
+    assert not fd.update(wobble[0], 0.5, 0.2, 1.5, 0.1, 0.1)  # less than half full
+    results = [fd.update(c, 0.5, 0.2, 1.5, 0.1, 0.1) for c in wobble[1:]]
+    assert results[3:] == [True] * 6  # from 5 of 10 entries on
+    turning = FailureDetector(10)
+    assert not any(turning.update(Velocity2D(0.0, 0.0, 0.3), 0.5, 0.2, 1.5, 0.1, 0.1)
+                   for _ in range(10))  # fmt: skip
+    driving = FailureDetector(10)
+    assert not any(driving.update(Velocity2D(0.3, 0.0, 0.3 * (-1) ** k), 0.5, 0.2, 1.5, 0.1, 0.1)
+                   for k in range(10))  # fmt: skip
+
+
+def test_oscillation_recovery_prefers_the_current_turning_direction() -> None:
+    """TebLocalPlannerROS::configureBackupModes: on an oscillation the robot's current
+    turning direction is kept (EdgePreferRotDir on the band's first three turns) for
+    oscillation_recovery_min_duration s, then released. The turn the band plans for a goal
+    straight behind the robot follows it."""
+    from roverlab.navigation.controllers.teb.recovery import OscillationRecovery
+    from roverlab.navigation.move_base.plugins import make_local_planner
+
+    teb, _, _ = make_local_planner(
+        "teb_local_planner/TebLocalPlannerROS",
+        {**TEB, "oscillation_filter_duration": 1.0, "oscillation_recovery_min_duration": 2.0},
+        footprint=FOOT,
+        controller_frequency=10.0,
+    )
+    params = teb.params  # type: ignore[attr-defined]
+    assert params.controller_frequency == 10.0  # move_base's, as TEB reads it
+    rec = OscillationRecovery(params)
+    t = 0.0
+    for k in range(10):  # 1 s of a wobble, the robot turning right at the end
+        out = rec.update(t, Velocity2D(0.0, 0.0, 0.2 * (-1) ** k), Velocity2D(0.0, 0.0, -0.1))
+        t += 0.1
+    assert out == -1
+    steady = Velocity2D(0.3, 0.0, 0.0)
+    held = []
+    while t < 5.0:
+        held.append(rec.update(t, steady, Velocity2D(0.3, 0.0, 0.0)))
+        t += 0.1
+    assert held[0] == -1 and held[-1] == 0  # held for 2 s after the last detection
+    assert 15 <= held.count(-1) <= 25
+    # a goal straight behind: the band turns right; preferring left holds its first three
+    # turns (TEB's EdgePreferRotDir penalises only the other direction) and the command
+    plan = np.column_stack([np.linspace(1.5, 0.5, 11), np.full(11, 1.5), np.full(11, math.pi)])
+    wz, first = {}, {}
+    for rotdir in (1, -1):
+        p = TebPlanner(params, footprint=FOOT)
+        p._recovery.preferred_rotdir, p._recovery.time_last_oscillation = rotdir, 0.0
+        wz[rotdir] = p.compute_velocity(SE2(1.5, 1.5, 0.0), Velocity2D(), plan, _open()).wz
+        first[rotdir] = p.band.poses[3, 2]
+    assert wz[-1] < -0.5 and first[-1] < -0.5
+    assert wz[1] > -0.2 and first[1] > -0.1, (wz, first)

@@ -108,7 +108,7 @@ def make_local_planner(
         )
         return DWAPlanner(dp, footprint=footprint, body_footprint=body_footprint), limits, warnings
     if plugin == "teb_local_planner/TebLocalPlannerROS":
-        tp, warnings = TebParams.from_ros(values)
+        tp, warnings = TebParams.from_ros({"controller_frequency": controller_frequency, **values})
         limits = LocalPlannerLimits(
             acc_lim_th=tp.acc_lim_theta,
             max_rotational_vel=tp.max_vel_theta,

@@ -10,7 +10,7 @@ TEB uses), written straight into the CSR data of the sparse Jacobian.
 Edge types: 0 velocity, 1 acceleration, 2 acceleration at the start (measured velocity),
 3 acceleration at the goal (goal velocity), 4 time optimal, 5 shortest path,
 6 kinematics (differential drive), 7 kinematics (car-like), 8 obstacle, 9 inflated
-obstacle, 10 via point.
+obstacle, 10 via point, 11 preferred turning direction (``aux[0]``: +1 left, -1 right).
 """
 
 from __future__ import annotations
@@ -32,10 +32,10 @@ __all__ = [
 _jit = numba.njit(cache=True, nogil=True)
 
 #: residuals per edge type
-EDGE_RESIDUALS = np.array([2, 2, 2, 2, 1, 1, 2, 2, 1, 2, 1], dtype=np.int64)
+EDGE_RESIDUALS = np.array([2, 2, 2, 2, 1, 1, 2, 2, 1, 2, 1, 1], dtype=np.int64)
 # which local slots an edge type reads: poses 0..2 (3 values each), dts 3..4
-_POSES_USED = np.array([2, 3, 2, 2, 0, 2, 2, 2, 1, 1, 1], dtype=np.int64)
-_DTS_USED = np.array([1, 2, 1, 1, 1, 0, 0, 0, 0, 0, 0], dtype=np.int64)
+_POSES_USED = np.array([2, 3, 2, 2, 0, 2, 2, 2, 1, 1, 1, 2], dtype=np.int64)
+_DTS_USED = np.array([1, 2, 1, 1, 1, 0, 0, 0, 0, 0, 0, 0], dtype=np.int64)
 _DELTA = 1e-7
 
 
@@ -206,8 +206,10 @@ def _edge_error(
         err[0] = e
         if et == 9:
             err[1] = _bound_below(d, cfg[8], 0.0)
-    else:
+    elif et == 10:
         err[0] = math.hypot(v[0] - aux[0], v[1] - aux[1])
+    else:  # TEB's EdgePreferRotDir
+        err[0] = _bound_below(aux[0] * _norm_angle(v[5] - v[2]), 0.0, 0.0)
 
 
 @_jit

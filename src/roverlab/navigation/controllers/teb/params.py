@@ -2,7 +2,7 @@
 names and defaults) and its ``footprint_model``.
 
 Names of teb_local_planner features roverlab does not implement (homotopy class
-planning, costmap_converter plugins, dynamic obstacles, recovery heuristics,
+planning, costmap_converter plugins, dynamic obstacles, the shrink-horizon backup mode,
 visualisation) are accepted with a warning naming them, and so is an unknown name (ROS
 ignores it). Homotopy class planning is on by default in teb: unless
 ``enable_homotopy_class_planning`` is false, a warning says it is not implemented.
@@ -51,7 +51,6 @@ _NOT_IMPLEMENTED = (
     "detours_orientation_tolerance",
     "length_start_orientation_vector",
     "max_ratio_detours_duration_best_duration",
-    "weight_prefer_rotdir",
     "include_dynamic_obstacles",
     "dynamic_obstacle_inflation_dist",
     "weight_dynamic_obstacle",
@@ -65,11 +64,6 @@ _NOT_IMPLEMENTED = (
     "costmap_converter_rate",
     "shrink_horizon_backup",
     "shrink_horizon_min_duration",
-    "oscillation_recovery",
-    "oscillation_v_eps",
-    "oscillation_omega_eps",
-    "oscillation_recovery_min_duration",
-    "oscillation_filter_duration",
     "divergence_detection_enable",
     "divergence_detection_max_chi_squared",
     "publish_feedback",
@@ -232,6 +226,19 @@ class TebParams:
     weight_inflation: float = 0.1
     weight_viapoint: float = 1.0
     weight_adapt_factor: float = 2.0
+    weight_prefer_rotdir: float = 50.0
+    #: TEB's oscillation recovery: when the last ``oscillation_filter_duration`` s of
+    #: commands oscillate (see :mod:`.recovery`), prefer the current turning direction
+    #: for ``oscillation_recovery_min_duration`` s (``weight_prefer_rotdir`` on the band's
+    #: first three turns)
+    oscillation_recovery: bool = True
+    oscillation_v_eps: float = 0.1
+    oscillation_omega_eps: float = 0.1
+    oscillation_recovery_min_duration: float = 10.0
+    oscillation_filter_duration: float = 10.0
+    #: move_base's (TEB reads it from there, 5 Hz without it): sizes the oscillation
+    #: filter and turns control cycles into seconds
+    controller_frequency: float = 5.0
 
     def __post_init__(self) -> None:
         w = "teb_local_planner"
@@ -262,6 +269,8 @@ class TebParams:
             if name.startswith("weight_"):
                 check(getattr(self, name) >= 0, f"{w}: {name} must be >= 0")
         check(self.weight_adapt_factor >= 1, f"{w}: weight_adapt_factor must be >= 1")
+        check(self.controller_frequency > 0, f"{w}: controller_frequency must be > 0")
+        check(self.oscillation_filter_duration >= 0, f"{w}: oscillation_filter_duration >= 0")
 
     @property
     def trans_limit(self) -> float:

@@ -9,6 +9,7 @@ Per control cycle, as TebLocalPlannerROS::computeVelocityCommands:
   (``global_plan_overwrite_orientation``); via-points every ``global_plan_viapoint_sep``;
 * the goal is reached within ``xy_goal_tolerance`` and ``yaw_goal_tolerance`` of the global
   goal, once stopped (or at once with ``free_goal_vel``): the command is then zero;
+* TEB's oscillation recovery (:mod:`.recovery`) may prefer a turning direction;
 * every lethal cell of the local costmap is a point obstacle
   (``include_costmap_obstacles``), except those behind the robot farther than
   ``costmap_obstacles_behind_robot_dist``;
@@ -46,6 +47,7 @@ from roverlab.navigation.controllers.teb.kernels import (
     evaluate,
 )
 from roverlab.navigation.controllers.teb.params import TebParams
+from roverlab.navigation.controllers.teb.recovery import OscillationRecovery
 from roverlab.navigation.controllers.teb.solver import band_order, levenberg_marquardt
 from roverlab.navigation.costmap.costmap_2d import LETHAL_OBSTACLE, Costmap2D
 from roverlab.navigation.costmap.footprint import footprint_radii
@@ -167,6 +169,10 @@ class TebPlanner:
         self._last_pose: SE2 | None = None
         self._last_twist = Velocity2D()
         self._line_buf = np.empty((4096, 2), dtype=np.int64)
+        self._recovery = OscillationRecovery(self.params)
+        self._cycles = 0  # control cycles: the oscillation recovery's clock
+        self._preferred_rotdir = 0  # TEB's RotType: +1 left, -1 right, 0 none
+        self._last_cmd = Velocity2D()
 
     @property
     def trajectory(self) -> NDArray[np.float64]:
@@ -330,6 +336,10 @@ class TebPlanner:
                 )
             else:
                 add(8, one, np.column_stack([m, m]), near[oo[:cnt]], (w_obs,))
+        if self._preferred_rotdir and p.weight_prefer_rotdir > 0:
+            k = min(n - 1, 3)  # TEB: the first three turns
+            m = np.full((k, 2), float(self._preferred_rotdir))
+            add(11, pair[:k], dt_none[:k], m, (p.weight_prefer_rotdir,))
         if p.weight_viapoint > 0 and len(self.via_points) and n >= 3:
             rows = []
             start_idx = 0
@@ -524,9 +534,27 @@ class TebPlanner:
         self._plan = _prune(pose, self._plan, p.global_plan_prune_distance)
         local, goal_idx = _transform(pose, self._plan, costmap, p.max_global_plan_lookahead_dist)
         self.via_points = self._via_points(local)
+        self._cycles += 1
         if self._goal_test(pose, twist):
             self.goal_reached = True
             return Velocity2D()
+        if p.oscillation_recovery:  # TEB's configureBackupModes (its oscillation part)
+            now = self._cycles / p.controller_frequency
+            self._preferred_rotdir = self._recovery.update(now, self._last_cmd, twist)
+        try:
+            cmd = self._cycle(pose, twist, costmap, local, goal_idx)
+        except NoValidControlError:
+            self._last_cmd = Velocity2D()  # TEB's last_cmd_ is the zero it commands then
+            raise
+        self._last_cmd = cmd
+        return cmd
+
+    def _cycle(
+        self, pose: SE2, twist: Velocity2D, costmap: Costmap2D, local: NDArray[np.float64],
+        goal_idx: int,
+    ) -> Velocity2D:  # fmt: skip
+        """The cycle after the goal test: local goal, obstacles, band, check, command."""
+        p = self.params
         if len(local) == 0:
             raise InvalidPathError("teb_local_planner: transformed plan is empty")
         local = local.copy()
