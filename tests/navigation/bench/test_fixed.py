@@ -8,6 +8,7 @@ from __future__ import annotations
 import csv
 import json
 import math
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -202,3 +203,33 @@ def test_a_fixed_episode_is_a_function_of_its_seed(tmp_path: Path) -> None:
     a, _ = run_fixed(cfg, write=False)
     b, _ = run_fixed(cfg, write=False)
     assert (a.status, a.time_s, a.record.driven_m) == (b.status, b.time_s, b.record.driven_m)
+
+
+def test_each_setup_is_warmed_up_once_per_process_with_a_short_episode(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import roverlab.navbench.fixed as fixed
+
+    made: list[FixedConfig] = []
+
+    class Fake:
+        def __init__(self, cfg: FixedConfig, log: object) -> None:
+            made.append(cfg)
+            self.ctx, self._tmp = self, self
+
+        def run(self) -> None:
+            pass
+
+        def shutdown(self) -> None:
+            pass
+
+        def cleanup(self) -> None:
+            pass
+
+    monkeypatch.setattr(fixed, "_Episode", Fake)
+    monkeypatch.setattr(fixed, "_warmed", set())
+    base = FixedConfig(world="w", out=tmp_path, start=(0, 0, 0), goal=(1, 0, 0), planner="teb")
+    fixed._warm_up(base)
+    fixed._warm_up(replace(base, world="other", seed=3))  # same setup: no second warm-up
+    fixed._warm_up(replace(base, planner="dwa"))
+    assert [(c.planner, c.time_limit_s) for c in made] == [("teb", 3.0), ("dwa", 3.0)]
