@@ -174,7 +174,10 @@ def test_trajectory_planner_ros_names_map_onto_dwa() -> None:
     assert (p.max_vel_x, p.min_vel_x, p.acc_lim_theta, p.vth_samples) == (0.3, 0.05, 2.0, 30)
     assert p.y_limits == (0.0, 0.0) and not p.meter_scoring
     assert (p.path_distance_bias, p.goal_distance_bias, p.forward_point_distance) == (0.4, 0.3, 0.0)
-    assert any("heading_lookahead" in w for w in warnings)
+    assert p.heading_lookahead == 0.3 and not p.in_place_samples  # roverlab's default
+    assert not any("heading_lookahead" in w for w in warnings)
+    ros, _ = DWAParams.from_trajectory_planner_ros({"in_place_rotations": True})
+    assert ros.in_place_samples
     holo, _ = DWAParams.from_trajectory_planner_ros({})
     assert holo.y_limits == (-0.3, 0.3) and holo.vy_samples == 4
     z, warnings = DWAParams.from_trajectory_planner_ros({"max_vel_z": 1.0})
@@ -193,7 +196,7 @@ def test_trajectory_planner_ros_escape_and_deprecated_names() -> None:
     assert p.min_vel_theta == 0.3
     text = "\n".join(warnings)
     assert "min_in_place_rotational_vel has been renamed to min_in_place_vel_theta" in text
-    assert "heading_lookahead has no effect" in text and "heading_scoring true" in text
+    assert "heading_lookahead" not in text and "heading_scoring true" in text
     assert "world_model 'voxel'" in text and "simple_attractor" not in text
     assert "odom_topic" not in text and "restore_defaults" not in text
     old, warnings = DWAParams.from_trajectory_planner_ros({"backup_vel": -0.2})

@@ -5,6 +5,7 @@ escape backs it out (its real footprint checked) and it drives through the door.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -105,3 +106,30 @@ def test_an_escape_blocked_behind_gives_forward_motion_back() -> None:
     room = Costmap2D(size_x=80, size_y=80, resolution=RES)
     only_back = dwa.compute_velocity(pose, Velocity2D(), plan, room)
     assert dwa.escaping and only_back == Velocity2D(-0.5, 0.0, 0.0)  # no forward sample
+
+
+def test_in_place_rotations_turn_a_robot_facing_a_dead_end() -> None:
+    """TrajectoryPlanner samples rotations in place (``min_in_place_vel_theta``) every
+    cycle, whatever ``min_vel_x`` is (``in_place_rotations: true``), and takes one when
+    its cost is not above the best arc's: in a 0.85 m wide pocket facing its end wall
+    (the plan behind) the robot turns where it stands; with both directions stuck it
+    drives the best arc; roverlab's default samples only the dynamic window (vx >= 0.1)
+    and backs up."""
+    cm = Costmap2D(size_x=80, size_y=80, resolution=RES)
+    cm.costs[31:49, 49] = cm.costs[31, 30:50] = cm.costs[48, 30:50] = 254  # open at -x
+    pose = SE2(2.0, 2.0, 0.0)  # 0.45 m from the end wall, 0.4 m from each side
+    plan = np.array([[2.0, 2.0, 0.0], [1.0, 2.0, 0.0], [0.5, 2.0, 0.0]])
+    dwa = _dwa(-0.5)
+    dwa.params = dataclasses.replace(dwa.params, in_place_samples=True)
+    cmd = dwa.compute_velocity(pose, Velocity2D(), plan, cm)
+    assert cmd.vx == 0.0 and abs(cmd.wz) >= 0.314 and not dwa.escaping, cmd
+    arcs = (dwa.samples[:, 0] > 0.0) & (dwa.costs >= 0)
+    turned = (dwa.samples == [cmd.vx, cmd.vy, cmd.wz]).all(axis=1)
+    assert arcs.any() and dwa.costs[turned][0] <= dwa.costs[arcs].min()
+    # the stuck flags: once it has turned one way after the other, that first way is out
+    r = dwa._rotations
+    r.rotating_left = r.rotating_right = r.stuck_left = r.stuck_right = True
+    r._prev = pose
+    assert dwa.compute_velocity(pose, Velocity2D(), plan, cm).vx > 0.0
+    # the default refuses every arc of its window here and backs up (world_245's loop)
+    assert _dwa(-0.5).compute_velocity(pose, Velocity2D(), plan, cm).vx < 0.0

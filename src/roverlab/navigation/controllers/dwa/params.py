@@ -67,6 +67,8 @@ _TP_DEFAULTS: dict[str, Any] = {
     "escape_reset_dist": 0.10,
     "escape_reset_theta": math.pi / 4,
     "heading_scoring": False,
+    "heading_lookahead": 0.325,
+    "in_place_rotations": False,  # roverlab's: True samples TrajectoryPlanner's rotations
     "simple_attractor": False,
     "world_model": "costmap",
 }
@@ -75,7 +77,6 @@ _TP_DEFAULTS: dict[str, Any] = {
 # min_vel_theta is not one of TrajectoryPlannerROS's parameters (min_in_place_vel_theta is)
 _TP_IGNORED = (
     "stop_time_buffer",
-    "heading_lookahead",
     "heading_scoring_timestep",
     "publish_cost_grid_pc",
     "global_frame_id",
@@ -109,6 +110,14 @@ class DWAParams:
     robot backs up at ``escape_vel`` (m/s, < 0; 0 turns escaping off) while its real
     footprint stays clear, and forward motion is not sampled until it has moved
     ``escape_reset_dist`` (m) or turned ``escape_reset_theta`` (rad) from where it began.
+
+    ``in_place_samples`` (TrajectoryPlannerROS's roverlab parameter ``in_place_rotations``,
+    default false): base_local_planner's TrajectoryPlanner also samples rotations in place
+    every cycle (``vx = 0``, the theta window's ``vth_samples`` speeds, at least
+    ``min_vel_theta`` = its ``min_in_place_vel_theta``), whatever ``min_vel_x`` is, and
+    picks among them by ``heading_lookahead`` (m) with its stuck flags (:mod:`.in_place`).
+    True is ROS's exact sampling; false (the default) samples only the dynamic window,
+    which measured better on BARN (docs/benchmarks.md).
     """
 
     max_vel_trans: float = 0.55
@@ -153,6 +162,8 @@ class DWAParams:
     escape_vel: float = -0.1
     escape_reset_dist: float = 0.10
     escape_reset_theta: float = math.pi / 4
+    in_place_samples: bool = False
+    heading_lookahead: float = 0.325
 
     def __post_init__(self) -> None:
         w = "dwa_local_planner"
@@ -181,6 +192,7 @@ class DWAParams:
             "goal_distance_bias",
             "occdist_scale",
             "twirling_scale",
+            "heading_lookahead",
         ):
             check(getattr(self, name) >= 0, f"{w}: {name} must be >= 0, got {getattr(self, name)}")
         check(self.min_vel_x <= self.max_vel_x, f"{w}: min_vel_x must be <= max_vel_x")
@@ -323,6 +335,8 @@ class DWAParams:
             "escape_vel": v["escape_vel"],
             "escape_reset_dist": v["escape_reset_dist"],
             "escape_reset_theta": v["escape_reset_theta"],
+            "in_place_samples": v["in_place_rotations"],
+            "heading_lookahead": v["heading_lookahead"],
             # TrajectoryPlannerROS reads stop_time_buffer, but the check that used it is
             # commented out in TrajectoryPlanner::generateTrajectory: a trajectory is
             # checked up to sim_time and no further

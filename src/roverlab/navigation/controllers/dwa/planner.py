@@ -48,6 +48,7 @@ from roverlab.navigation.controllers.base import (
     prune_plan,
     stopped,
 )
+from roverlab.navigation.controllers.dwa.in_place import InPlaceRotations, in_place_samples
 from roverlab.navigation.controllers.dwa.kernels import (
     first_known_stretch,
     rollout,
@@ -158,6 +159,9 @@ class DWAPlanner:
         self._xy_latch = False
         self._rotating = False
         self._reset_oscillation()
+        self._rotations = InPlaceRotations(
+            self.params.heading_lookahead, self.params.oscillation_reset_dist
+        )
         self._prev_stationary = SE2()
         self._grids: tuple[NDArray[np.float64], ...] = ()
         self._scales = np.zeros(7)
@@ -314,6 +318,8 @@ class DWAPlanner:
         ys = velocity_iterator(lo[1], hi[1], ny)
         ths = velocity_iterator(lo[2], hi[2], nth)
         grid = np.array(np.meshgrid(xs, ys, ths, indexing="ij")).reshape(3, -1).T
+        if p.in_place_samples:  # TrajectoryPlanner's, whatever min_vel_x is
+            grid = np.concatenate([grid, in_place_samples(lo[2], hi[2], nth, p.min_vel_theta)])
         return np.ascontiguousarray(grid, dtype=np.float64)
 
     def _update_oscillation(self, pose: SE2, cmd: NDArray[np.float64]) -> None:
@@ -391,6 +397,8 @@ class DWAPlanner:
         # TrajectoryPlanner samples no forward motion while escaping
         samples = every[every[:, 0] <= 0.0] if self.escaping else every
         best, costs = self._best(pose, twist, samples, costmap)
+        if best >= 0 and p.in_place_samples:
+            best = self._pick_in_place(pose, twist, samples, costs, costmap)
         if best < 0:
             back = self._back_up(pose, twist, costmap)
             if back is not None:
@@ -416,6 +424,25 @@ class DWAPlanner:
         )  # fmt: skip
         self.trajectory = traj[:n].copy()
         return Velocity2D(float(cmd[0]), float(cmd[1]), float(cmd[2]))
+
+    def _pick_in_place(
+        self, pose: SE2, vel: Velocity2D, samples: NDArray[np.float64],
+        costs: NDArray[np.float64], cm: Costmap2D,
+    ) -> int:  # fmt: skip
+        """TrajectoryPlanner's choice between the best sample and its rotations in place
+        (:class:`.in_place.InPlaceRotations`), from the rotations' end poses."""
+        p = self.params
+        ends = np.zeros((len(samples), 3))
+        acc = np.array([p.acc_lim_x, p.acc_lim_y, p.acc_lim_theta])
+        traj = np.empty((int(p.sim_time / min(p.sim_granularity, 1.0)) * 4 + 64, 3))
+        for k in np.flatnonzero((samples[:, 0] == 0.0) & (costs >= 0)):
+            num, _, _ = rollout(
+                pose.as_array(), vel.as_array(), samples[k], p.sim_time, p.sim_granularity,
+                p.angular_sim_granularity, not p.use_dwa, acc, 0.0, traj,
+            )  # fmt: skip
+            ends[k] = traj[num - 1] if num else pose.as_array()
+        origin = (cm.resolution, cm.origin_x, cm.origin_y)
+        return self._rotations.pick(pose, samples, costs, ends, self._grids[1], origin)
 
     def _escape(
         self, pose: SE2, vel: Velocity2D, samples: NDArray[np.float64], cm: Costmap2D,
