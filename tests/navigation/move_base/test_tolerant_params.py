@@ -83,11 +83,12 @@ def test_barn_and_book_parameter_files_start_move_base(caplog: pytest.LogCapture
         text = caplog.text
         assert text.count("global_costmap: unknown parameter 'meter_scoring'") == 1
         assert text.count("local_costmap: unknown parameter 'meter_scoring'") == 1
-        assert "base_local_planner: parameter heading_lookahead has no effect" in text
+        assert "base_local_planner: parameter heading_scoring_timestep has no effect" in text
         scan = _obstacle(mb.local_costmap.params).observation_sources[0]
         assert (scan.min_obstacle_height, scan.max_obstacle_height) == (-2.0, 2.0)
         ctrl: Any = mb.controller
         assert (ctrl.params.escape_vel, ctrl.params.escape_reset_dist) == (-0.5, 0.1)
+        assert ctrl.params.heading_lookahead == 0.325 and "heading_lookahead" not in text
         book = {f"{ns}/{k}": v for ns in ("global_costmap", "local_costmap")
                 for k, v in flatten_ros(BOOK_COMMON).items()}  # fmt: skip
         book["global_costmap/global_frame"] = "odom"
