@@ -133,3 +133,26 @@ def test_in_place_rotations_turn_a_robot_facing_a_dead_end() -> None:
     assert dwa.compute_velocity(pose, Velocity2D(), plan, cm).vx > 0.0
     # the default refuses every arc of its window here and backs up (world_245's loop)
     assert _dwa(-0.5).compute_velocity(pose, Velocity2D(), plan, cm).vx < 0.0
+
+
+def test_a_stalled_robot_turns_in_place_and_the_progress_check_resets_when_it_moves() -> None:
+    """roverlab's progress check (Nav2's SimpleProgressChecker names): the default
+    samples no rotation in place, so in the pocket it backs up, drives back in and
+    repeats (BARN world_245 for 78 s); after ``movement_time_allowance`` within
+    ``required_movement_radius`` it samples TrajectoryPlanner's rotations and turns."""
+    cm = Costmap2D(size_x=80, size_y=80, resolution=RES)
+    cm.costs[31:49, 49] = cm.costs[31, 30:50] = cm.costs[48, 30:50] = 254  # open at -x
+    pose = SE2(2.0, 2.0, 0.0)
+    plan = np.array([[2.0, 2.0, 0.0], [1.0, 2.0, 0.0], [0.5, 2.0, 0.0]])
+    base = _dwa(-0.5)
+    assert base.params.movement_time_allowance == 10.0  # TrajectoryPlannerROS's default
+    p = dataclasses.replace(base.params, movement_time_allowance=0.2)  # 4 cycles at 20 Hz
+    dwa = DWAPlanner(p, footprint=base.footprint, body_footprint=BODY)
+    cmds = [dwa.compute_velocity(pose, Velocity2D(), plan, cm) for _ in range(6)]
+    assert all(c.vx < 0.0 for c in cmds[:4]), cmds  # backing up, not yet stalled
+    assert cmds[-1].vx == 0.0 and abs(cmds[-1].wz) >= 0.314, cmds  # turns in place
+    # 0.6 m on, the window starts again: no rotation until stalled again
+    assert not dwa._progress.stalled(SE2(1.4, 2.0, 0.0)) and not dwa._progress.is_stalled
+    off = dataclasses.replace(p, movement_time_allowance=0.0)  # 0: never (window only)
+    never = DWAPlanner(off, footprint=base.footprint, body_footprint=BODY)
+    assert all(never.compute_velocity(pose, Velocity2D(), plan, cm).vx < 0 for _ in range(6))

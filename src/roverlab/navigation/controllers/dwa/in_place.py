@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 
 from roverlab.geometry import SE2
 
-__all__ = ["InPlaceRotations", "in_place_samples"]
+__all__ = ["InPlaceRotations", "ProgressCheck", "in_place_samples"]
 
 
 def in_place_samples(lo: float, hi: float, num: int, min_in_place: float) -> NDArray[np.float64]:
@@ -99,3 +99,29 @@ class InPlaceRotations:
         if math.hypot(pose.x - self._prev.x, pose.y - self._prev.y) > self.reset_dist:
             self.reset(self._prev)
         return best
+
+
+class ProgressCheck:
+    """Nav2's SimpleProgressChecker on the control cycles: the robot is stalled once it
+    has stayed within ``radius`` m of where the window began for more than
+    ``allowance`` s (cycles x ``period``), and stays stalled until it is ``radius`` m
+    from there. ``allowance`` 0: never stalled."""
+
+    def __init__(self, radius: float, allowance: float, period: float) -> None:
+        self.radius, self.allowance, self.period = radius, allowance, period
+        self._anchor: SE2 | None = None
+        self._cycles = 0
+        self.is_stalled = False
+
+    def stalled(self, pose: SE2) -> bool:
+        """Called once per control cycle with the robot's pose."""
+        if self.allowance <= 0:
+            return False
+        a = self._anchor
+        if a is None or math.hypot(pose.x - a.x, pose.y - a.y) > self.radius:
+            self._anchor, self._cycles, self.is_stalled = pose, 0, False
+            return False
+        self._cycles += 1
+        if self._cycles * self.period > self.allowance:
+            self.is_stalled = True
+        return self.is_stalled

@@ -69,6 +69,9 @@ _TP_DEFAULTS: dict[str, Any] = {
     "heading_scoring": False,
     "heading_lookahead": 0.325,
     "in_place_rotations": False,  # roverlab's: True samples TrajectoryPlanner's rotations
+    # roverlab's (Nav2's SimpleProgressChecker names): the rotations once stalled
+    "required_movement_radius": 0.5,
+    "movement_time_allowance": 10.0,
     "simple_attractor": False,
     "world_model": "costmap",
 }
@@ -117,7 +120,10 @@ class DWAParams:
     ``min_vel_theta`` = its ``min_in_place_vel_theta``), whatever ``min_vel_x`` is, and
     picks among them by ``heading_lookahead`` (m) with its stuck flags (:mod:`.in_place`).
     True is ROS's exact sampling; false (the default) samples only the dynamic window,
-    which measured better on BARN (docs/benchmarks.md).
+    which measured better on BARN (docs/benchmarks.md), until the robot stalls:
+    ``movement_time_allowance`` (s; TrajectoryPlannerROS default 10, DWAPlannerROS 0 =
+    never) without moving ``required_movement_radius`` (m, 0.5), Nav2's progress
+    checker names, turns the rotations on until it has moved that far.
     """
 
     max_vel_trans: float = 0.55
@@ -164,6 +170,8 @@ class DWAParams:
     escape_reset_theta: float = math.pi / 4
     in_place_samples: bool = False
     heading_lookahead: float = 0.325
+    required_movement_radius: float = 0.5
+    movement_time_allowance: float = 0.0
 
     def __post_init__(self) -> None:
         w = "dwa_local_planner"
@@ -193,6 +201,8 @@ class DWAParams:
             "occdist_scale",
             "twirling_scale",
             "heading_lookahead",
+            "required_movement_radius",
+            "movement_time_allowance",
         ):
             check(getattr(self, name) >= 0, f"{w}: {name} must be >= 0, got {getattr(self, name)}")
         check(self.min_vel_x <= self.max_vel_x, f"{w}: min_vel_x must be <= max_vel_x")
@@ -337,6 +347,8 @@ class DWAParams:
             "escape_reset_theta": v["escape_reset_theta"],
             "in_place_samples": v["in_place_rotations"],
             "heading_lookahead": v["heading_lookahead"],
+            "required_movement_radius": v["required_movement_radius"],
+            "movement_time_allowance": v["movement_time_allowance"],
             # TrajectoryPlannerROS reads stop_time_buffer, but the check that used it is
             # commented out in TrajectoryPlanner::generateTrajectory: a trajectory is
             # checked up to sim_time and no further

@@ -48,7 +48,11 @@ from roverlab.navigation.controllers.base import (
     prune_plan,
     stopped,
 )
-from roverlab.navigation.controllers.dwa.in_place import InPlaceRotations, in_place_samples
+from roverlab.navigation.controllers.dwa.in_place import (
+    InPlaceRotations,
+    ProgressCheck,
+    in_place_samples,
+)
 from roverlab.navigation.controllers.dwa.kernels import (
     first_known_stretch,
     rollout,
@@ -161,6 +165,11 @@ class DWAPlanner:
         self._reset_oscillation()
         self._rotations = InPlaceRotations(
             self.params.heading_lookahead, self.params.oscillation_reset_dist
+        )
+        self._progress = ProgressCheck(
+            self.params.required_movement_radius,
+            self.params.movement_time_allowance,
+            self.params.sim_period,
         )
         self._prev_stationary = SE2()
         self._grids: tuple[NDArray[np.float64], ...] = ()
@@ -292,7 +301,9 @@ class DWAPlanner:
         cost = self._score(pose, vel, cmd[None, :], cm, self._only)[1][0]
         return bool(cost >= 0 or cost == -100.0)
 
-    def _sample_velocities(self, pose: SE2, vel: Velocity2D) -> NDArray[np.float64]:
+    def _sample_velocities(
+        self, pose: SE2, vel: Velocity2D, rotations: bool = False
+    ) -> NDArray[np.float64]:
         p = self.params
         g = self._goal()
         max_th = p.max_vel_theta
@@ -318,7 +329,7 @@ class DWAPlanner:
         ys = velocity_iterator(lo[1], hi[1], ny)
         ths = velocity_iterator(lo[2], hi[2], nth)
         grid = np.array(np.meshgrid(xs, ys, ths, indexing="ij")).reshape(3, -1).T
-        if p.in_place_samples:  # TrajectoryPlanner's, whatever min_vel_x is
+        if rotations:  # TrajectoryPlanner's, whatever min_vel_x is
             grid = np.concatenate([grid, in_place_samples(lo[2], hi[2], nth, p.min_vel_theta)])
         return np.ascontiguousarray(grid, dtype=np.float64)
 
@@ -393,11 +404,12 @@ class DWAPlanner:
         if self._position_reached(pose):
             return self._stop_rotate(pose, twist, costmap)
         self._update_escape(pose)
-        every = self._sample_velocities(pose, twist)
+        rotations = p.in_place_samples or self._progress.stalled(pose)
+        every = self._sample_velocities(pose, twist, rotations)
         # TrajectoryPlanner samples no forward motion while escaping
         samples = every[every[:, 0] <= 0.0] if self.escaping else every
         best, costs = self._best(pose, twist, samples, costmap)
-        if best >= 0 and p.in_place_samples:
+        if best >= 0 and rotations:
             best = self._pick_in_place(pose, twist, samples, costs, costmap)
         if best < 0:
             back = self._back_up(pose, twist, costmap)
