@@ -145,7 +145,7 @@ def test_a_stalled_robot_turns_in_place_and_the_progress_check_resets_when_it_mo
     pose = SE2(2.0, 2.0, 0.0)
     plan = np.array([[2.0, 2.0, 0.0], [1.0, 2.0, 0.0], [0.5, 2.0, 0.0]])
     base = _dwa(-0.5)
-    assert base.params.movement_time_allowance == 10.0  # TrajectoryPlannerROS's default
+    assert base.params.movement_time_allowance == 20.0  # TrajectoryPlannerROS's default
     p = dataclasses.replace(base.params, movement_time_allowance=0.2)  # 4 cycles at 20 Hz
     dwa = DWAPlanner(p, footprint=base.footprint, body_footprint=BODY)
     cmds = [dwa.compute_velocity(pose, Velocity2D(), plan, cm) for _ in range(6)]

@@ -71,7 +71,7 @@ _TP_DEFAULTS: dict[str, Any] = {
     "in_place_rotations": False,  # roverlab's: True samples TrajectoryPlanner's rotations
     # roverlab's (Nav2's SimpleProgressChecker names): the rotations once stalled
     "required_movement_radius": 0.5,
-    "movement_time_allowance": 10.0,
+    "movement_time_allowance": 20.0,
     "simple_attractor": False,
     "world_model": "costmap",
 }
@@ -121,7 +121,7 @@ class DWAParams:
     picks among them by ``heading_lookahead`` (m) with its stuck flags (:mod:`.in_place`).
     True is ROS's exact sampling; false (the default) samples only the dynamic window,
     which measured better on BARN (docs/benchmarks.md), until the robot stalls:
-    ``movement_time_allowance`` (s; TrajectoryPlannerROS default 10, DWAPlannerROS 0 =
+    ``movement_time_allowance`` (s; TrajectoryPlannerROS default 20, DWAPlannerROS 0 =
     never) without moving ``required_movement_radius`` (m, 0.5), Nav2's progress
     checker names, turns the rotations on until it has moved that far.
     """
