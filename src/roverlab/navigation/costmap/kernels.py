@@ -143,6 +143,19 @@ def line_cost(
 
 
 @_jit
+def _grow_bounds(bounds: NDArray[np.float64], n: int, x: float, y: float) -> None:
+    """``bounds`` (min x, min y, max x, max y) after ``n`` points, grown to hold ``(x, y)``."""
+    if n == 0:
+        bounds[0] = bounds[2] = x
+        bounds[1] = bounds[3] = y
+    else:
+        bounds[0] = min(bounds[0], x)
+        bounds[1] = min(bounds[1], y)
+        bounds[2] = max(bounds[2], x)
+        bounds[3] = max(bounds[3], y)
+
+
+@_jit
 def clear_rays(
     grid: NDArray[np.uint8],
     gx0: float,
@@ -240,14 +253,7 @@ def raytrace_freespace(
         scale = min(1.0, raytrace_range / full) if full > 0 else 1.0
         ex = ox + dx * scale
         ey = oy + dy * scale
-        if n == 0:
-            bounds[0] = bounds[2] = ex
-            bounds[1] = bounds[3] = ey
-        else:
-            bounds[0] = min(bounds[0], ex)
-            bounds[1] = min(bounds[1], ey)
-            bounds[2] = max(bounds[2], ex)
-            bounds[3] = max(bounds[3], ey)
+        _grow_bounds(bounds, n, ex, ey)
         n += 1
     return n
 
@@ -289,14 +295,7 @@ def mark_observation(
         if mx >= w or my >= h:
             continue
         grid[my, mx] = value
-        if n == 0:
-            bounds[0] = bounds[2] = px
-            bounds[1] = bounds[3] = py
-        else:
-            bounds[0] = min(bounds[0], px)
-            bounds[1] = min(bounds[1], py)
-            bounds[2] = max(bounds[2], px)
-            bounds[3] = max(bounds[3], py)
+        _grow_bounds(bounds, n, px, py)
         n += 1
     return n
 
