@@ -272,34 +272,6 @@ def test_jackal_band_pushes_out_a_post_that_appears_inside_it() -> None:
     assert len(poses) < 40 and length < 5.0, (len(poses), length)
 
 
-def test_jackal_band_turning_back_sees_the_posts_its_check_tests() -> None:
-    """BARN world_85 (and world_64) at 0.5 m/s: the robot heads 30 degrees left, the new
-    global plan turns right past a post 1.2 m away and just behind the robot. TEB drops
-    costmap cells behind the robot farther than costmap_obstacles_behind_robot_dist from
-    the band's obstacles, but isTrajectoryFeasible checks every cell under the padded
-    footprint up to feasibility_check_lookahead_distance: with the old file's 1.0 m the
-    optimiser never saw the post, the re-initialised band was the same one every cycle
-    and always "not feasible", and move_base aborted with the robot in open space."""
-    params = _jackal()
-    reach = params.feasibility_check_lookahead_distance + float(
-        np.hypot(*pad_footprint(_BODY, 0.1).T).max()
-    )
-    assert params.costmap_obstacles_behind_robot_dist >= reach
-    cm = Costmap2D(size_x=100, size_y=100, resolution=0.05)  # 5 x 5 m
-    cm.costs[25:31, 30:39] = 254  # the post cluster right of the turn (x 1.5..1.95 m)
-    plan = np.vstack(
-        [
-            np.column_stack([np.full(16, 1.02), np.linspace(2.52, 1.0, 16), np.zeros(16)]),
-            np.column_stack([np.linspace(1.1, 3.0, 20), np.full(20, 0.85), np.zeros(20)]),
-        ]
-    )
-    teb = TebPlanner(params, footprint=pad_footprint(_BODY, 0.1))
-    for _ in range(3):  # each cycle starts from a cleared planner, as after a reset
-        teb.band.clear()
-        cmd = teb.compute_velocity(SE2(1.02, 2.52, 0.52), Velocity2D(), plan, cm)
-        assert cmd.wz < 0  # turning right, towards the plan
-
-
 def test_failure_detector_flags_a_robot_turning_back_and_forth() -> None:
     """TEB's FailureDetector: normalised commands, detection from half a buffer, mean
     speeds below the eps and more than one sign change of the angular velocity."""
