@@ -80,6 +80,14 @@ def _point(x: float, y: float, z: float) -> Any:
     return _xyz(_Point, _POINT, x, y, z)
 
 
+def _pose(position: Any, orientation: Any) -> Any:
+    pose = _new(_Pose)
+    pose.position = position
+    pose.orientation = orientation
+    pose.__msgtype__ = _POSE
+    return pose
+
+
 def _quaternion(x: float, y: float, z: float, w: float) -> Any:
     q = _new(_Quaternion)
     q.x = x
@@ -149,12 +157,7 @@ def odometry(
     """``nav_msgs/Odometry``: stamp, frames, position, orientation, linear and angular
     velocity, with the two covariances."""
     h = _header(sec, nanosec, frame_id)
-    p = _point(x, y, z)
-    q = _quaternion(qx, qy, qz, qw)
-    pose = _new(_Pose)
-    pose.position = p
-    pose.orientation = q
-    pose.__msgtype__ = _POSE
+    pose = _pose(_point(x, y, z), _quaternion(qx, qy, qz, qw))
     pc = _new(_PoseCov)
     pc.pose = pose
     pc.covariance = pose_covariance
@@ -204,12 +207,7 @@ def pose_stamped(
     """``geometry_msgs/PoseStamped``: stamp, frame, position, orientation (move_base's
     feedback)."""
     h = _header(sec, nanosec, frame_id)
-    p = _point(x, y, z)
-    q = _quaternion(qx, qy, qz, qw)
-    pose = _new(_Pose)
-    pose.position = p
-    pose.orientation = q
-    pose.__msgtype__ = _POSE
+    pose = _pose(_point(x, y, z), _quaternion(qx, qy, qz, qw))
     m = _new(_PoseStamped)
     m.header = h
     m.pose = pose
