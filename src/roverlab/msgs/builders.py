@@ -162,14 +162,8 @@ def odometry(
     pc.pose = pose
     pc.covariance = pose_covariance
     pc.__msgtype__ = _POSE_COV
-    lin = _vector3(vx, vy, vz)
-    ang = _vector3(wx, wy, wz)
-    tw = _new(_Twist)
-    tw.linear = lin
-    tw.angular = ang
-    tw.__msgtype__ = _TWIST
     tc = _new(_TwistCov)
-    tc.twist = tw
+    tc.twist = twist(vx, vy, vz, wx, wy, wz)
     tc.covariance = twist_covariance
     tc.__msgtype__ = _TWIST_COV
     m = _new(_Odometry)

@@ -21,17 +21,22 @@ from tests.core.ros1.conftest import SCRIPTS, run_ros, stop
 from tests.helpers.net import free_port
 
 
-def test_declared_parameters_are_on_the_master_and_rosparam_set_reaches_the_node(
-    real_master: str,
-) -> None:
-    env = {**os.environ, "ROS_MASTER_URI": real_master, "ROS_HOSTNAME": "127.0.0.1"}
-    node = subprocess.Popen(
-        [sys.executable, str(SCRIPTS / "param_node.py")],
+def _param_node(master: str, *args: str) -> subprocess.Popen[str]:
+    """scripts/param_node.py (a roverlab node) under ``master``."""
+    env = {**os.environ, "ROS_MASTER_URI": master, "ROS_HOSTNAME": "127.0.0.1"}
+    return subprocess.Popen(
+        [sys.executable, str(SCRIPTS / "param_node.py"), *args],
         env=env,
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
     )
+
+
+def test_declared_parameters_are_on_the_master_and_rosparam_set_reaches_the_node(
+    real_master: str,
+) -> None:
+    node = _param_node(real_master)
     try:
         assert node.stdout is not None
         assert node.stdout.readline().strip() == "READY 0.5 slow 12.0 odom"
@@ -84,14 +89,7 @@ def test_values_set_on_the_master_before_a_node_starts_win_over_its_defaults(
         ("/early_node/frame", "map"),
     ):
         assert run_ros(real_master, "/usr/bin/rosparam", "set", name, value).returncode == 0
-    env = {**os.environ, "ROS_MASTER_URI": real_master, "ROS_HOSTNAME": "127.0.0.1"}
-    node = subprocess.Popen(
-        [sys.executable, str(SCRIPTS / "param_node.py"), "early_node"],
-        env=env,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
+    node = _param_node(real_master, "early_node")
     try:
         assert node.stdout is not None
         assert node.stdout.readline().strip() == "READY 0.7 fast 12.0 odom"
