@@ -27,6 +27,7 @@ from roverlab.navbench.suite import (
     run_suite,
     summarize,
 )
+from tests.helpers.barn_layout import write_barn_layout
 from tests.helpers.nodes import run_main
 
 
@@ -133,42 +134,17 @@ def test_bad_fixed_goal_options_are_one_line_exit_2(
 
 
 # move_base files in BARN's layout, written for this test (odometry frame, laser costmaps)
-_PARAMS = {
-    "costmap_common_params.yaml": """\
-footprint: [[-0.21, -0.165], [-0.21, 0.165], [0.21, 0.165], [0.21, -0.165]]
-footprint_padding: 0.05
-plugins:
-- {name: obstacles_layer, type: "costmap_2d::ObstacleLayer"}
-- {name: inflater_layer, type: "costmap_2d::InflationLayer"}
-obstacles_layer:
-  observation_sources: scan
-  scan: {sensor_frame: front_laser, data_type: LaserScan, topic: front/scan, marking: true,
-         clearing: true, obstacle_range: 2.5, raytrace_range: 3.0}
-inflater_layer: {inflation_radius: 0.3}
-""",
-    "global_costmap_params.yaml": """\
-global_costmap: {global_frame: odom, robot_base_frame: base_link, update_frequency: 5,
-                 width: 12.0, height: 12.0, resolution: 0.05, origin_x: -6.0, origin_y: -6.0,
-                 rolling_window: false}
-""",
-    "local_costmap_params.yaml": """\
-local_costmap: {global_frame: odom, robot_base_frame: base_link, update_frequency: 10,
-                width: 4.0, height: 4.0, resolution: 0.05, rolling_window: true}
-""",
-    "base_local_planner_params.yaml": """\
+_PLANNER = """\
 TrajectoryPlannerROS: {max_vel_x: 0.5, min_vel_x: 0.1, acc_lim_x: 10.0, acc_lim_theta: 20.0,
   max_vel_theta: 1.57, min_in_place_vel_theta: 0.314, xy_goal_tolerance: 0.25,
   yaw_goal_tolerance: 0.157, sim_time: 2.0, vx_samples: 6, vtheta_samples: 20, dwa: true,
   controller_frequency: 10.0, occdist_scale: 0.1, pdist_scale: 0.75, gdist_scale: 1.0}
-""",
-}
+"""
 
 
 def _room(tmp_path: Path) -> FixedConfig:
     params = tmp_path / "params"
-    params.mkdir()
-    for name, text in _PARAMS.items():
-        (params / name).write_text(text)
+    write_barn_layout(params, _PLANNER, padding=0.05, global_hz=5, global_size_m=12.0, local_hz=10)
     world = tmp_path / "room.yaml"
     world.write_text(
         "name: room\nwalls:\n- points: [[-1, -2], [5, -2], [5, 2], [-1, 2]]\n  closed: true\n"

@@ -19,34 +19,13 @@ from roverlab.navigation.move_base.recovery import RotateRecovery
 from roverlab.sim.app import Simulation
 from roverlab.sim.node import SpawnPose
 from roverlab.world import load_world
+from tests.helpers.barn_layout import write_barn_layout
 
 #: ahead and to the left: its surface 0.325 m ahead (the body ends at 0.21, the padded
 #: footprint at 0.31), within the padded footprint's circumscribed radius (0.41 m)
 PILLAR = (0.40, 0.20)
-_PARAMS = {
-    "costmap_common_params.yaml": """\
-footprint: [[-0.21, -0.165], [-0.21, 0.165], [0.21, 0.165], [0.21, -0.165]]
-footprint_padding: 0.1
-plugins:
-- {name: obstacles_layer, type: "costmap_2d::ObstacleLayer"}
-- {name: inflater_layer, type: "costmap_2d::InflationLayer"}
-obstacles_layer:
-  observation_sources: scan
-  scan: {sensor_frame: front_laser, data_type: LaserScan, topic: front/scan, marking: true,
-         clearing: true, obstacle_range: 2.5, raytrace_range: 3.0}
-inflater_layer: {inflation_radius: 0.3}
-""",
-    "global_costmap_params.yaml": """\
-global_costmap: {global_frame: odom, robot_base_frame: base_link, update_frequency: 10,
-                 width: 8.0, height: 8.0, resolution: 0.05, origin_x: -4.0, origin_y: -4.0,
-                 rolling_window: false}
-""",
-    "local_costmap_params.yaml": """\
-local_costmap: {global_frame: odom, robot_base_frame: base_link, update_frequency: 20,
-                width: 4.0, height: 4.0, resolution: 0.05, rolling_window: true}
-""",
-    # BARN's base_local_planner_params.yaml (TrajectoryPlannerROS, dwa: true)
-    "base_local_planner_params.yaml": """\
+# BARN's base_local_planner_params.yaml (TrajectoryPlannerROS, dwa: true)
+_PLANNER = """\
 TrajectoryPlannerROS: {acc_lim_x: 10.0, acc_lim_theta: 20.0, max_vel_x: 0.5, min_vel_x: 0.1,
   max_vel_theta: 1.57, min_in_place_vel_theta: 0.314, holonomic_robot: false,
   escape_vel: -0.5, yaw_goal_tolerance: 0.157, xy_goal_tolerance: 0.25, sim_time: 2.0,
@@ -54,8 +33,7 @@ TrajectoryPlannerROS: {acc_lim_x: 10.0, acc_lim_theta: 20.0, max_vel_x: 0.5, min
   controller_frequency: 20.0, meter_scoring: true, occdist_scale: 0.1, pdist_scale: 0.75,
   gdist_scale: 1.0, dwa: true, oscillation_reset_dist: 0.05, escape_reset_dist: 0.1,
   escape_reset_theta: 0.1}
-""",
-}
+"""
 _LAUNCH = """\
 <launch>
   <param name="/use_sim_time" value="true"/>
@@ -84,8 +62,7 @@ def _goal(x: float, y: float) -> dict[str, object]:
 def test_after_an_abort_a_wedged_robot_gets_out_and_reaches_the_next_goal(
     tmp_path: Path,
 ) -> None:
-    for name, text in _PARAMS.items():
-        (tmp_path / name).write_text(text)
+    write_barn_layout(tmp_path, _PLANNER, padding=0.1, global_hz=10, global_size_m=8.0, local_hz=20)
     world = tmp_path / "pillar.yaml"
     world.write_text(
         "name: pillar\nwalls:\n- points: [[-1.5, -1.5], [3.5, -1.5], [3.5, 1.5], [-1.5, 1.5]]\n"
