@@ -3,10 +3,16 @@ explore_lite), scored against the world, and the same figures again with the sam
 
 from __future__ import annotations
 
+import gc
 import json
 import math
+import sys
+import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
+import numba
 import numpy as np
 import pytest
 
@@ -46,6 +52,46 @@ def test_the_same_seed_gives_the_same_episode(episodes: tuple[ExploreEpisode, ..
     np.testing.assert_array_equal(
         np.asarray(episodes[0].map_msg.data), np.asarray(episodes[1].map_msg.data)
     )
+
+
+@contextmanager
+def _thread_timing_shaken() -> Iterator[None]:
+    """A thread that holds the GIL as much as it can, a thread switch every 10 us, a garbage
+    collection every 100 allocations and one numba thread instead of the machine's: what a
+    loaded machine (or a test process with threads left over) changes in a run."""
+    stop = threading.Event()
+
+    def busy() -> None:
+        while not stop.is_set():
+            _ = [object() for _ in range(100)]
+
+    switch, threshold = sys.getswitchinterval(), gc.get_threshold()
+    threads = numba.get_num_threads()
+    thread = threading.Thread(target=busy, daemon=True)
+    sys.setswitchinterval(1e-5)
+    gc.set_threshold(100)
+    numba.set_num_threads(1)
+    thread.start()
+    try:
+        yield
+    finally:
+        stop.set()
+        thread.join()
+        sys.setswitchinterval(switch)
+        gc.set_threshold(*threshold)
+        numba.set_num_threads(threads)
+
+
+def test_thread_timing_does_not_steer_a_seeded_episode(
+    episodes: tuple[ExploreEpisode, ...],
+) -> None:
+    # the first 15 s of the same seed, run while threads and the collector are shaken, are
+    # the first 15 s of the episode run undisturbed (the last sample repeats t = 15 s)
+    with _thread_timing_shaken():
+        short = run_explore(world="maze", slam="gmapping", seed=3, duration_s=15.0)
+    path = short.monitor.world_path
+    assert len(path) > 100
+    np.testing.assert_array_equal(path[:-1], episodes[0].monitor.world_path[: len(path) - 1])
 
 
 def test_outputs_are_the_map_the_plots_and_the_summary(
