@@ -195,6 +195,9 @@ def test_from_ros_takes_a_launch_files_params() -> None:
         ("use_odometry", 1),
         ("motion_prediction", "kalman"),
         ("scan_match_angle_search_step", 0.0),
+        ("revisit_search", -1.0),
+        ("revisit_fit_ratio", 0.0),
+        ("revisit_confirmations", 0),
     ],
 )
 def test_bad_parameters_are_rejected(field: str, value: object) -> None:

@@ -198,13 +198,14 @@ def run_hector(records: LaserLog, params: dict[str, object]) -> MethodResult:
     if int(slam.grid.sizes[0]) != hp.map_size:
         notes.append(f"hector map grown to {int(slam.grid.sizes[0])} cells per side")
     g = slam.guard_counts
-    if hp.use_odometry and (g.degenerate or g.jumps or g.collapsed or g.rival):
+    if hp.use_odometry and (g.degenerate or g.jumps or g.collapsed or g.rival or g.revisits):
         notes.append(
             f"hector: {g.degenerate} degenerate matches kept the odometry along the weak "
             f"direction, {g.jumps} matches jumping faster than the robot can move and "
             f"{g.collapsed} collapsed matches were replaced by the odometry, "
             f"{g.rival} matches from the scan-only prediction fitted better than the "
-            "odometry's"
+            f"odometry's, {g.revisits} corrections found on a revisit were taken "
+            f"({g.unmapped} scans left unmapped while they were confirmed)"
         )
     if slam.runaway is not None:
         notes.append(slam.runaway.warning())

@@ -111,6 +111,18 @@ class HectorParams:
             checks above and fits the map better (hector's cost ``sum (1 - M)^2``) is
             taken: odometry that stalls and then catches up at once (mit-csail's, while
             turning) would otherwise start the match tens of degrees off; 0 turns it off.
+        revisit_search: (roverlab, with odometry) half-width (m) of the wide search for
+            the map on a revisit (:mod:`roverlab.slam.hector.revisit`): a match that puts
+            fewer than ``revisit_trigger`` of the endpoints on occupied cells is searched
+            for over this distance around it; 0 turns it off.
+        revisit_angle_search: (roverlab) half-width (rad) of that search in heading.
+        revisit_trigger: (roverlab) the share of endpoints on occupied cells below which
+            the search runs.
+        revisit_fit_ratio: (roverlab) a place the search finds is a candidate when its
+            cost ``sum (1 - M)^2`` is at most this share of the match's.
+        revisit_confirmations: (roverlab) a candidate is taken once this many scans in a
+            row find candidates that agree with the odometry between them; until then the
+            scans are not mapped.
     """
 
     map_resolution: float = 0.025
@@ -140,6 +152,11 @@ class HectorParams:
     max_angular_velocity: float = 4.0
     max_free_endpoints: float = 0.5
     rival_match_threshold: float = 0.1
+    revisit_search: float = 1.0
+    revisit_angle_search: float = 0.05
+    revisit_trigger: float = 0.7
+    revisit_fit_ratio: float = 0.6
+    revisit_confirmations: int = 3
 
     def __post_init__(self) -> None:
         for f in dataclasses.fields(self):
@@ -198,6 +215,11 @@ class HectorParams:
         _check(self.max_angular_velocity >= 0.0, "max_angular_velocity must be >= 0")
         _check(0.0 < self.max_free_endpoints <= 1.0, "max_free_endpoints must be in (0, 1]")
         _check(self.rival_match_threshold >= 0.0, "rival_match_threshold must be >= 0")
+        _check(0.0 <= self.revisit_search <= 5.0, "revisit_search must be in [0, 5] m")
+        _check(0.0 <= self.revisit_angle_search <= 0.5, "revisit_angle_search must be in [0, 0.5]")
+        _check(0.0 <= self.revisit_trigger <= 1.0, "revisit_trigger must be in [0, 1]")
+        _check(0.0 < self.revisit_fit_ratio <= 1.0, "revisit_fit_ratio must be in (0, 1]")
+        _check(self.revisit_confirmations >= 1, "revisit_confirmations must be >= 1")
 
     @classmethod
     def from_ros(cls, params: Mapping[str, Any]) -> HectorParams:

@@ -37,14 +37,13 @@ from roverlab.slam.hector.errors import HectorInputError, OutOfMapError
 from roverlab.slam.hector.grid import HectorMap, MultiResGrid
 from roverlab.slam.hector.matcher import match
 from roverlab.slam.hector.params import HectorParams
+from roverlab.slam.hector.revisit import OCCUPIED_ABOVE, SEARCH_EVERY, Revisit
 from roverlab.slam.laser import beam_endpoints
 
 __all__ = ["GuardCounts", "HectorRun", "HectorSLAM", "Runaway", "ScanLike", "run_log"]
 
 #: A cell the map holds free has a value below this (two free observations: 0.31).
 _FREE_BELOW = 0.35
-#: ... and an occupied one above this (one hit: 0.9).
-_OCCUPIED_ABOVE = 0.6
 
 _IDENTITY = SE2()
 
@@ -74,12 +73,17 @@ class GuardCounts:
         collapsed: matches rejected for putting the scan on free space.
         rival: matches started from the scan-only prediction that fitted the map better
             than the one started from the odometry's.
+        revisits: corrections found by the wide search on a revisit and taken
+            (:mod:`roverlab.slam.hector.revisit`).
+        unmapped: scans not mapped while such a correction waited for its confirmations.
     """
 
     degenerate: int = 0
     jumps: int = 0
     collapsed: int = 0
     rival: int = 0
+    revisits: int = 0
+    unmapped: int = 0
 
 
 class HectorSLAM:
@@ -133,6 +137,7 @@ class HectorSLAM:
         self._last_stamp: float | None = None
         self._period = 0.0
         self.guard_counts = GuardCounts()
+        self._revisits = Revisit()
         self.largest_jump = (0.0, math.nan)
         self.runaway: Runaway | None = None
 
@@ -236,7 +241,8 @@ class HectorSLAM:
                 "odom_pose is required with map_with_known_poses or use_odometry"
             )
 
-        accept = True
+        accept, snapped = True, False
+        odom_step: NDArray[np.float64] | None = None
         if p.map_with_known_poses:
             assert odom is not None
             pose = odom.copy()
@@ -248,13 +254,15 @@ class HectorSLAM:
             guarded = p.use_odometry and odom is not None and self._last_odom is not None
             if guarded:
                 assert odom is not None and self._last_odom is not None
-                pose = _compose(pose, _relative(self._last_odom, odom))
+                odom_step = _relative(self._last_odom, odom)
+                pose = _compose(pose, odom_step)
             else:
                 pose = scan_only
             if pts.shape[0] and self.grid.updates:
                 predicted = pose
-                if guarded:
+                if odom_step is not None:
                     pose, accept = self._guarded_match(pts, predicted, scan_only, stamp)
+                    pose, accept, snapped = self._revisit(pts, pose, accept, odom_step)
                 else:
                     pose, self.last_hessian = self._match(pts, predicted)
         pose[2] = wrap_angle(float(pose[2]))
@@ -263,7 +271,10 @@ class HectorSLAM:
         self._grow_to_hold(pose, pts)
         self._check_inside(pose)
         self._last_odom = odom
-        self._last_motion = _relative(self._pose, pose)
+        # (a revisit's correction is no motion to repeat)
+        self._last_motion = (
+            odom_step if snapped and odom_step is not None else _relative(self._pose, pose)
+        )
         self._pose = pose
         self._last_stamp = stamp
         self.scans_processed += 1
@@ -346,7 +357,7 @@ class HectorSLAM:
         values = map_values(prob, k, centre, pose, pts)
         if p.degenerate_eigen_ratio > 0.0:
             # only surfaces the map already holds fix the robot against the map
-            ratio, weak = scan_constraint(pts, values > _OCCUPIED_ABOVE)
+            ratio, weak = scan_constraint(pts, values > OCCUPIED_ABOVE)
             if ratio < p.degenerate_eigen_ratio:
                 pose = odometry_along(pose, predicted, weak)
                 degenerate = True
@@ -356,6 +367,34 @@ class HectorSLAM:
             if share > p.max_free_endpoints:
                 return pose, "collapsed", values, degenerate
         return pose, "ok", values, degenerate
+
+    def _revisit(
+        self,
+        pts: NDArray[np.float64],
+        pose: NDArray[np.float64],
+        accept: bool,
+        odom_step: NDArray[np.float64],
+    ) -> tuple[NDArray[np.float64], bool, bool]:
+        """The revisit check (:mod:`roverlab.slam.hector.revisit`) of the guarded match
+        ``pose``; returns the pose, whether the scan may be mapped and whether the pose is
+        a confirmed correction."""
+        p = self.params
+        if p.revisit_search <= 0.0 or (
+            self._revisits.count == 0 and self.scans_processed % SEARCH_EVERY
+        ):
+            return pose, accept, False
+        hit = self._revisits.search(self.grid, p, pts, pose)
+        if hit is None:
+            self._revisits.reset()
+            return pose, accept, False
+        found, hessian = hit
+        if self._revisits.offer(found, odom_step) < p.revisit_confirmations:
+            self.guard_counts.unmapped += int(accept)
+            return pose, False, False
+        self._revisits.reset()
+        self.guard_counts.revisits += 1
+        self.last_hessian = hessian
+        return found, True, True
 
     def _scan_period(self, stamp: float | None) -> float:
         """The time since the previous scan, at least the usual scan period (a running
