@@ -10,6 +10,7 @@ import pytest
 from roverlab.geometry import Transform3, quat_from_rpy
 from roverlab.navigation.costmap.kernels import (
     clear_rays,
+    combine_max,
     mark_observation,
     raytrace_freespace,
     scan_points,
@@ -118,3 +119,21 @@ def test_scan_points_are_the_projection_then_the_transform() -> None:
         want = tf.apply(project_scan(ranges, angles, 0.1, 10.0, inf_is_valid=inf_is_valid))
         assert got.shape == want.shape and len(got) > 400
         np.testing.assert_array_equal(got, want)
+
+
+def test_combine_max_is_update_with_max() -> None:
+    """CostmapLayer::updateWithMax: the layer's known cost where the master cell is unknown
+    or lower, in the window only."""
+    rng = np.random.default_rng(8)
+    values = np.array([0, 1, 100, 253, 254, 255], dtype=np.uint8)
+    for _ in range(30):
+        master = rng.choice(values, size=(23, 31))
+        own = rng.choice(values, size=(23, 31))
+        x0, xn = sorted(int(v) for v in rng.integers(0, 35, 2))
+        y0, yn = sorted(int(v) for v in rng.integers(0, 26, 2))
+        want = master.copy()
+        m, o = want[y0:yn, x0:xn], own[y0:yn, x0:xn]
+        take = (o != 255) & ((m == 255) | (m < o))
+        m[take] = o[take]
+        combine_max(master, own, x0, y0, xn, yn)
+        np.testing.assert_array_equal(master, want)

@@ -19,6 +19,7 @@ __all__ = [
     "bresenham",
     "cells_cost",
     "clear_rays",
+    "combine_max",
     "convex_fill",
     "footprint_cells",
     "footprint_cost",
@@ -581,3 +582,22 @@ def outline_cells(
         gx0 = gx
         gy0 = gy
     return n
+
+
+@_jit
+def combine_max(
+    master: NDArray[np.uint8], own: NDArray[np.uint8], x0: int, y0: int, xn: int, yn: int
+) -> None:
+    """costmap_2d's ``CostmapLayer::updateWithMax`` on the window ``[x0, xn) x [y0, yn)``:
+    a master cell takes the layer's cost where the layer knows it and the master cell is
+    unknown or lower. The window is clipped to both grids."""
+    h = min(master.shape[0], own.shape[0])
+    w = min(master.shape[1], own.shape[1])
+    for j in range(max(y0, 0), min(yn, h)):
+        for i in range(max(x0, 0), min(xn, w)):
+            c = own[j, i]
+            if c == NO_INFO:
+                continue
+            m = master[j, i]
+            if m == NO_INFO or m < c:
+                master[j, i] = c
