@@ -11,6 +11,7 @@ from roverlab.geometry import Transform3, quat_from_rpy
 from roverlab.navigation.costmap.kernels import (
     clear_rays,
     combine_max,
+    height_filter,
     mark_observation,
     raytrace_freespace,
     scan_points,
@@ -137,3 +138,18 @@ def test_combine_max_is_update_with_max() -> None:
         m[take] = o[take]
         combine_max(master, own, x0, y0, xn, yn)
         np.testing.assert_array_equal(master, want)
+
+
+def test_height_filter_is_the_numpy_mask() -> None:
+    rng = np.random.default_rng(9)
+    pts = rng.uniform(-3, 3, size=(500, 3))
+    pts[rng.integers(0, 500, 60), rng.integers(0, 3, 60)] = np.nan
+    pts[rng.integers(0, 500, 30), rng.integers(0, 3, 30)] = np.inf
+    pts[rng.integers(0, 500, 30), 2] = -1.0  # on the lower limit: kept
+    for lo, hi in ((-1.0, 2.0), (-np.inf, np.inf), (0.5, 0.5), (1.0, -1.0)):
+        z = pts[:, 2]
+        with np.errstate(invalid="ignore"):
+            keep = (z <= hi) & (z >= lo) & np.isfinite(pts).all(axis=1)
+        got = height_filter(pts, lo, hi)
+        assert got.shape == (int(keep.sum()), 3)
+        np.testing.assert_array_equal(got, pts[keep])

@@ -23,6 +23,7 @@ __all__ = [
     "convex_fill",
     "footprint_cells",
     "footprint_cost",
+    "height_filter",
     "inflate",
     "line_cost",
     "mark_observation",
@@ -601,3 +602,34 @@ def combine_max(
             m = master[j, i]
             if m == NO_INFO or m < c:
                 master[j, i] = c
+
+
+@_jit
+def height_filter(
+    points: NDArray[np.float64], min_height: float, max_height: float
+) -> NDArray[np.float64]:
+    """The rows of ``points`` (``(N, 3)``) with ``min_height <= z <= max_height`` and every
+    coordinate finite, in order (an ObservationBuffer's height filter)."""
+    n = points.shape[0]
+    keep = np.empty(n, dtype=np.bool_)
+    m = 0
+    for k in range(n):
+        x = points[k, 0]
+        y = points[k, 1]
+        z = points[k, 2]
+        ok = (
+            z <= max_height and z >= min_height
+            and math.isfinite(x) and math.isfinite(y) and math.isfinite(z)
+        )  # fmt: skip
+        keep[k] = ok
+        if ok:
+            m += 1
+    out = np.empty((m, 3))
+    j = 0
+    for k in range(n):
+        if keep[k]:
+            out[j, 0] = points[k, 0]
+            out[j, 1] = points[k, 1]
+            out[j, 2] = points[k, 2]
+            j += 1
+    return out

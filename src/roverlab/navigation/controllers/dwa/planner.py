@@ -299,7 +299,7 @@ class DWAPlanner(EscapeMixin):
         grids: list[NDArray[np.float64]] = []
         for i, seeds in enumerate(self._seeds):
             if i == 2 and seeds is self._seeds[1]:
-                grids.append(grids[1].copy())
+                grids.append(grids[1])  # the same wave (the grids are only read)
             elif len(seeds) == 0:
                 grids.append(np.full(shape, float(cm.size_x * cm.size_y + 1)))
             else:
@@ -372,7 +372,10 @@ class DWAPlanner(EscapeMixin):
         xs = velocity_iterator(lo[0], hi[0], nx)
         ys = velocity_iterator(lo[1], hi[1], ny)
         ths = velocity_iterator(lo[2], hi[2], nth)
-        grid = np.array(np.meshgrid(xs, ys, ths, indexing="ij")).reshape(3, -1).T
+        grid = np.empty((len(xs) * len(ys) * len(ths), 3))  # every (x, y, th), th fastest
+        grid[:, 0] = np.repeat(xs, len(ys) * len(ths))
+        grid[:, 1] = np.tile(np.repeat(ys, len(ths)), len(xs))
+        grid[:, 2] = np.tile(ths, len(xs) * len(ys))
         if rotations:  # TrajectoryPlanner's, whatever min_vel_x is
             grid = np.concatenate([grid, in_place_samples(lo[2], hi[2], nth, p.min_vel_theta)])
         return np.ascontiguousarray(grid, dtype=np.float64)
