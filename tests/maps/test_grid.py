@@ -8,7 +8,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from roverlab.maps import CountGrid, GridError, LogOddsGrid, ScanRays, save_map, trace_cells
+from roverlab.maps import (
+    CountGrid,
+    GridError,
+    LogOddsGrid,
+    ScanRays,
+    save_map,
+    trace_cells,
+)
+from roverlab.maps.raytrace import trace_segment_cells
 from roverlab.msgs import occupancy_grid_to_array, xytheta_from_pose
 from tests.maps.helpers import (
     ref_beams,
@@ -331,3 +339,58 @@ def test_scan_rays_rules() -> None:
     assert rays.hit.tolist() == [True, False, False, False]
     assert np.allclose(rays.ends, [[1.0, 3.0], [1.0, 4.0], [1.0, 4.0], [1.0, 4.0]])
     assert rays.bounds() == pytest.approx((1.0, 2.0, 1.0, 4.0))
+
+
+def _trace_each_step(gx0: float, gy0: float, gx1: float, gy1: float, w: int, h: int) -> list[int]:
+    """The tracer's loop as it was, both border parameters recomputed at every step."""
+    dx, dy = gx1 - gx0, gy1 - gy0
+    t0, t1 = 0.0, 1.0
+    for p, q in ((-dx, gx0), (dx, w - gx0), (-dy, gy0), (dy, h - gy0)):
+        if p == 0.0:
+            if q < 0.0:
+                t0, t1 = 1.0, 0.0
+            continue
+        r = q / p
+        if p < 0.0:
+            t0 = max(t0, r)
+        else:
+            t1 = min(t1, r)
+    if t0 > t1:
+        return []
+    ix = min(max(math.floor(gx0 + t0 * dx), 0), w - 1)
+    iy = min(max(math.floor(gy0 + t0 * dy), 0), h - 1)
+    sx = 1 if dx > 0 else (-1 if dx < 0 else 0)
+    sy = 1 if dy > 0 else (-1 if dy < 0 else 0)
+    ox, oy = int(dx > 0), int(dy > 0)
+    out = []
+    while len(out) < w + h + 4:
+        out.append(iy * w + ix)
+        tx = (ix + ox - gx0) / dx if sx else math.inf
+        ty = (iy + oy - gy0) / dy if sy else math.inf
+        if tx <= ty:
+            if tx >= t1:
+                break
+            ix += sx
+            if not 0 <= ix < w:
+                break
+        else:
+            if ty >= t1:
+                break
+            iy += sy
+            if not 0 <= iy < h:
+                break
+    return out
+
+
+def test_trace_recomputes_a_border_only_when_its_cell_changes() -> None:
+    """The same cells, bit for bit, as computing both borders at every step (also for
+    segments through cell corners, where x and y borders tie)."""
+    rng = np.random.default_rng(7)
+    buf = np.empty(64, dtype=np.int64)
+    for k in range(3000):
+        w, h = int(rng.integers(1, 25)), int(rng.integers(1, 25))
+        pts = rng.uniform(-3, 28, 4)
+        if k % 3 == 0:
+            pts = np.round(pts * 2) / 2  # on cell borders and corners
+        n = trace_segment_cells(*pts, w, h, buf)
+        assert buf[:n].tolist() == _trace_each_step(*pts, w, h), k

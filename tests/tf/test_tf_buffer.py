@@ -442,3 +442,20 @@ def test_tree_as_text_shows_the_tree(robot: BufferCore) -> None:
     assert lines[5] == "world"
     assert lines[6].startswith("└── table  [broadcaster: sim")
     assert BufferCore().tree_as_text() == "no tf data received\n"
+
+
+def test_a_lookup_repeated_at_a_stamp_sees_data_that_arrived_in_between() -> None:
+    """Lookups are remembered per (target, source, stamp) only until the data changes."""
+    buf = BufferCore()
+    buf.set_transform("odom", "base_link", s(1.0), tf(x=0.0))
+    buf.set_transform("odom", "base_link", s(3.0), tf(x=2.0))
+    first, _ = buf.lookup_transform("odom", "base_link", s(2.0))
+    again, _ = buf.lookup_transform("odom", "base_link", s(2.0))
+    assert (
+        first.translation[0] == pytest.approx(1.0) and again.translation[0] == first.translation[0]
+    )
+    buf.set_transform("odom", "base_link", s(2.0), tf(x=5.0))  # late data at that stamp
+    assert buf.lookup_transform("odom", "base_link", s(2.0))[0].translation[0] == 5.0
+    buf.clear()
+    with pytest.raises(TransformException):
+        buf.lookup_transform("odom", "base_link", s(2.0))

@@ -57,23 +57,27 @@ def _trace(
     offy = 1 if dy > 0.0 else 0
     cap = out.shape[0]
     n = 0
+    # the parameter of the next x / y cell border; each is recomputed (by the same
+    # expression) only when its cell index changed
+    tx = (ix + offx - gx0) / dx if stepx != 0 else math.inf
+    ty = (iy + offy - gy0) / dy if stepy != 0 else math.inf
     while n < cap:
         out[n] = iy * w + ix
         n += 1
-        tx = (ix + offx - gx0) / dx if stepx != 0 else math.inf
-        ty = (iy + offy - gy0) / dy if stepy != 0 else math.inf
         if tx <= ty:
             if tx >= t1:
                 break
             ix += stepx
             if ix < 0 or ix >= w:
                 break
+            tx = (ix + offx - gx0) / dx
         else:
             if ty >= t1:
                 break
             iy += stepy
             if iy < 0 or iy >= h:
                 break
+            ty = (iy + offy - gy0) / dy
     return n
 
 

@@ -46,6 +46,8 @@ DEFAULT_CACHE_TIME: Final = Duration(10_000_000_000)
 """How long a dynamic edge keeps its past (tf2's default: 10 s)."""
 MAX_GRAPH_DEPTH: Final = 1000
 """Longest chain walked before the tree is declared to contain a loop (as tf2)."""
+_FOUND_MAX: Final = 256
+"""Lookups remembered between two changes of the data (then all forgotten at once)."""
 DEFAULT_AUTHORITY: Final = "default_authority"
 """Authority recorded when the broadcaster is unknown (what tf2_ros' Python listener uses)."""
 
@@ -89,6 +91,9 @@ class BufferCore:
         self._cache_ns = ns
         self._frames: dict[str, None] = {}  # every frame id ever seen, in order of arrival
         self._caches: dict[str, Cache] = {}  # child frame id -> its data
+        # (target, source, stamp) -> the pose found, until the data next changes: a
+        # message is looked up several times at its stamp (message filters, costmaps)
+        self._found: dict[tuple[str, str, int], Pose] = {}
         self._authority: dict[str, str] = {}
 
     @property
@@ -173,6 +178,7 @@ class BufferCore:
             )
         n = math.sqrt(n2)
         sample: Sample = (parent, (tx, ty, tz, qx / n, qy / n, qz / n, qw / n))
+        self._found.clear()
         self._frames.setdefault(child, None)
         self._frames.setdefault(parent, None)
         cache = self._caches.get(child)
@@ -189,6 +195,7 @@ class BufferCore:
 
     def clear(self) -> None:
         """Drop all dynamic data (static transforms and known frame ids stay), as tf2."""
+        self._found.clear()
         for cache in self._caches.values():
             cache.clear()
 
@@ -415,6 +422,18 @@ class BufferCore:
                 cache = self._caches.get(target)
                 t_ns = cache.latest_stamp() if cache is not None else 0
             return IDENTITY, t_ns
+        if t_ns != 0:
+            key = (target, source, t_ns)
+            found = self._found.get(key)
+            if found is None:
+                found = self._lookup_pose_at(target, source, t_ns)[0]
+                if len(self._found) >= _FOUND_MAX:
+                    self._found.clear()
+                self._found[key] = found
+            return found, t_ns
+        return self._lookup_pose_at(target, source, t_ns)
+
+    def _lookup_pose_at(self, target: str, source: str, t_ns: int) -> tuple[Pose, int]:
         frames = self._frames
         if target not in frames:
             self._validate("lookupTransform argument target_frame", target)

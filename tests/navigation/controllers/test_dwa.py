@@ -225,3 +225,37 @@ def test_trajectory_planner_checks_a_trajectory_up_to_sim_time_only() -> None:
     vel = Velocity2D(0.5, 0.0, 0.0)
     assert dwa._score(pose, vel, fast, cm, dwa._only)[1][0] >= 0
     assert dwa.compute_velocity(pose, vel, plan, cm).vx == pytest.approx(0.5)
+
+
+def test_waves_stopped_at_the_reach_window_choose_what_whole_waves_choose(
+    dwa_params: DWAParams, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The map grids are final only near the robot; every sample's cost and the command
+    are the same as with the waves run to their end, also when a read falls outside
+    the window (the scoring then has the waves run to their end)."""
+    rng = np.random.default_rng(12)
+    stopped = 0
+    for _ in range(6):
+        cm = _open(200)
+        cells = rng.integers(0, 200, size=(400, 2))
+        cm.costs[cells[:, 1], cells[:, 0]] = rng.choice([254, 253, 200, 120], size=400)
+        pose = SE2(5.0, 5.0, float(rng.uniform(-3, 3)))
+        plan = np.array([[5.0, 5.0, 0.0], [6.0, 5.5, 0.0], [7.5, 7.0, 0.0], [9.9, 9.0, 0.0]])
+        twist = Velocity2D(0.2, 0.0, 0.1)
+        answers = []
+        for window in ("reach", "whole", "one cell"):
+            dwa = DWAPlanner(dwa_params, footprint=FOOT)
+            if window == "whole":
+                monkeypatch.setattr(dwa, "_reach_window", lambda p, c: np.array([0, 0, 199, 199]))
+            elif window == "one cell":
+                monkeypatch.setattr(dwa, "_reach_window", lambda p, c: np.array([0, 0, 0, 0]))
+            try:
+                cmd = dwa.compute_velocity(pose, twist, plan, cm)
+            except NoValidControlError as err:
+                answers.append((str(err), None, None))
+                continue
+            if window == "reach":
+                stopped += int(dwa._window[2] - dwa._window[0] < 199)
+            answers.append((cmd, dwa.samples.tolist(), dwa.costs.tolist()))
+        assert answers[0] == answers[1] == answers[2]
+    assert stopped >= 3  # the waves did stop at the window

@@ -8,7 +8,7 @@ from collections import deque
 
 import numpy as np
 
-from roverlab.navigation.controllers.dwa.kernels import target_distance
+from roverlab.navigation.controllers.dwa.kernels import target_distance, target_distance_window
 from roverlab.navigation.controllers.dwa.planner import _adjust_resolution
 
 
@@ -48,6 +48,35 @@ def test_target_distance_is_the_breadth_first_wave() -> None:
         out = np.empty((h, w))
         target_distance(costs, np.array(seeds, dtype=np.int64), out)
         np.testing.assert_array_equal(out, _reference_wave(costs, seeds))
+
+
+def test_the_wave_stopped_at_a_window_has_the_final_values_inside_it() -> None:
+    rng = np.random.default_rng(5)
+    values = np.array([0, 40, 252, 253, 254, 255], dtype=np.uint8)
+    stopped = 0
+    for _ in range(300):
+        h, w = (int(v) for v in rng.integers(1, 40, 2))
+        sparse = rng.random() < 0.7
+        p = [0.7, 0.15, 0.03, 0.04, 0.05, 0.03] if sparse else [0.55, 0.2, 0.05, 0.07, 0.08, 0.05]
+        costs = rng.choice(values, size=(h, w), p=p)
+        n = int(rng.integers(1, 6))
+        seeds = [(int(rng.integers(0, w)), int(rng.integers(0, h))) for _ in range(n)]
+        x0, x1 = sorted(int(v) for v in rng.integers(-3, w + 3, 2))
+        y0, y1 = sorted(int(v) for v in rng.integers(-3, h + 3, 2))
+        x1, y1 = max(x1, 0), max(y1, 0)  # the window overlaps the grid
+        out = np.empty((h, w))
+        ended = target_distance_window(
+            costs, np.array(seeds, dtype=np.int64), out, np.array([x0, y0, x1, y1])
+        )
+        ref = _reference_wave(costs, seeds)
+        cx0, cy0, cx1, cy1 = max(x0, 0), max(y0, 0), min(x1, w - 1), min(y1, h - 1)
+        inside = ref[cy0 : cy1 + 1, cx0 : cx1 + 1]
+        np.testing.assert_array_equal(out[cy0 : cy1 + 1, cx0 : cx1 + 1], inside)
+        if ended:
+            np.testing.assert_array_equal(out, ref)
+        else:
+            stopped += 1
+    assert stopped > 50  # the wave did stop early in many of the cases
 
 
 def test_adjust_resolution_inserts_even_points_up_to_the_resolution() -> None:

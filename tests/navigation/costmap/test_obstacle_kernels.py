@@ -10,6 +10,8 @@ import pytest
 from roverlab.geometry import Transform3, quat_from_rpy
 from roverlab.navigation.costmap.kernels import (
     clear_rays,
+    combine_max,
+    height_filter,
     mark_observation,
     raytrace_freespace,
     scan_points,
@@ -118,3 +120,36 @@ def test_scan_points_are_the_projection_then_the_transform() -> None:
         want = tf.apply(project_scan(ranges, angles, 0.1, 10.0, inf_is_valid=inf_is_valid))
         assert got.shape == want.shape and len(got) > 400
         np.testing.assert_array_equal(got, want)
+
+
+def test_combine_max_is_update_with_max() -> None:
+    """CostmapLayer::updateWithMax: the layer's known cost where the master cell is unknown
+    or lower, in the window only."""
+    rng = np.random.default_rng(8)
+    values = np.array([0, 1, 100, 253, 254, 255], dtype=np.uint8)
+    for _ in range(30):
+        master = rng.choice(values, size=(23, 31))
+        own = rng.choice(values, size=(23, 31))
+        x0, xn = sorted(int(v) for v in rng.integers(0, 35, 2))
+        y0, yn = sorted(int(v) for v in rng.integers(0, 26, 2))
+        want = master.copy()
+        m, o = want[y0:yn, x0:xn], own[y0:yn, x0:xn]
+        take = (o != 255) & ((m == 255) | (m < o))
+        m[take] = o[take]
+        combine_max(master, own, x0, y0, xn, yn)
+        np.testing.assert_array_equal(master, want)
+
+
+def test_height_filter_is_the_numpy_mask() -> None:
+    rng = np.random.default_rng(9)
+    pts = rng.uniform(-3, 3, size=(500, 3))
+    pts[rng.integers(0, 500, 60), rng.integers(0, 3, 60)] = np.nan
+    pts[rng.integers(0, 500, 30), rng.integers(0, 3, 30)] = np.inf
+    pts[rng.integers(0, 500, 30), 2] = -1.0  # on the lower limit: kept
+    for lo, hi in ((-1.0, 2.0), (-np.inf, np.inf), (0.5, 0.5), (1.0, -1.0)):
+        z = pts[:, 2]
+        with np.errstate(invalid="ignore"):
+            keep = (z <= hi) & (z >= lo) & np.isfinite(pts).all(axis=1)
+        got = height_filter(pts, lo, hi)
+        assert got.shape == (int(keep.sum()), 3)
+        np.testing.assert_array_equal(got, pts[keep])

@@ -19,9 +19,11 @@ __all__ = [
     "bresenham",
     "cells_cost",
     "clear_rays",
+    "combine_max",
     "convex_fill",
     "footprint_cells",
     "footprint_cost",
+    "height_filter",
     "inflate",
     "line_cost",
     "mark_observation",
@@ -581,3 +583,53 @@ def outline_cells(
         gx0 = gx
         gy0 = gy
     return n
+
+
+@_jit
+def combine_max(
+    master: NDArray[np.uint8], own: NDArray[np.uint8], x0: int, y0: int, xn: int, yn: int
+) -> None:
+    """costmap_2d's ``CostmapLayer::updateWithMax`` on the window ``[x0, xn) x [y0, yn)``:
+    a master cell takes the layer's cost where the layer knows it and the master cell is
+    unknown or lower. The window is clipped to both grids."""
+    h = min(master.shape[0], own.shape[0])
+    w = min(master.shape[1], own.shape[1])
+    for j in range(max(y0, 0), min(yn, h)):
+        for i in range(max(x0, 0), min(xn, w)):
+            c = own[j, i]
+            if c == NO_INFO:
+                continue
+            m = master[j, i]
+            if m == NO_INFO or m < c:
+                master[j, i] = c
+
+
+@_jit
+def height_filter(
+    points: NDArray[np.float64], min_height: float, max_height: float
+) -> NDArray[np.float64]:
+    """The rows of ``points`` (``(N, 3)``) with ``min_height <= z <= max_height`` and every
+    coordinate finite, in order (an ObservationBuffer's height filter)."""
+    n = points.shape[0]
+    keep = np.empty(n, dtype=np.bool_)
+    m = 0
+    for k in range(n):
+        x = points[k, 0]
+        y = points[k, 1]
+        z = points[k, 2]
+        ok = (
+            z <= max_height and z >= min_height
+            and math.isfinite(x) and math.isfinite(y) and math.isfinite(z)
+        )  # fmt: skip
+        keep[k] = ok
+        if ok:
+            m += 1
+    out = np.empty((m, 3))
+    j = 0
+    for k in range(n):
+        if keep[k]:
+            out[j, 0] = points[k, 0]
+            out[j, 1] = points[k, 1]
+            out[j, 2] = points[k, 2]
+            j += 1
+    return out

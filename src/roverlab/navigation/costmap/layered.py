@@ -27,6 +27,7 @@ from roverlab.navigation.costmap.costmap_2d import (
     Costmap2D,
 )
 from roverlab.navigation.costmap.footprint import footprint_radii
+from roverlab.navigation.costmap.kernels import combine_max
 
 __all__ = ["Bounds", "CostmapLayer", "Layer", "LayeredCostmap"]
 
@@ -148,9 +149,7 @@ class CostmapLayer(Layer):
 
     def update_with_max(self, master: Costmap2D, x0: int, y0: int, xn: int, yn: int) -> None:
         """Master cells take the larger cost; an unknown master cell takes the layer's."""
-        m, own = self._windows(master, x0, y0, xn, yn)
-        take = (own != NO_INFORMATION) & ((m == NO_INFORMATION) | (m < own))
-        m[take] = own[take]
+        combine_max(master.costs, self.grid.costs, x0, y0, xn, yn)
 
     def update_with_addition(self, master: Costmap2D, x0: int, y0: int, xn: int, yn: int) -> None:
         """Sum of the costs, kept below inscribed; an unknown master cell takes the layer's."""

@@ -38,7 +38,11 @@ from roverlab.navigation.costmap.costmap_2d import (
     Costmap2D,
 )
 from roverlab.navigation.costmap.footprint import transform_footprint
-from roverlab.navigation.costmap.kernels import mark_observation, raytrace_freespace
+from roverlab.navigation.costmap.kernels import (
+    height_filter,
+    mark_observation,
+    raytrace_freespace,
+)
 from roverlab.navigation.costmap.layered import Bounds, CostmapLayer
 from roverlab.navigation.errors import CostmapError
 from roverlab.navigation.params import check
@@ -210,13 +214,10 @@ class ObservationBuffer:
     def _observation(
         self, origin: NDArray[np.float64], points: ArrayLike, stamp_s: float
     ) -> Observation:
-        pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+        pts = np.ascontiguousarray(np.asarray(points, dtype=np.float64).reshape(-1, 3))
         p = self.params
-        z = pts[:, 2]
-        with np.errstate(invalid="ignore"):
-            keep = (z <= p.max_obstacle_height) & (z >= p.min_obstacle_height)
-        keep &= np.isfinite(pts).all(axis=1)
-        return Observation(origin, pts[keep], p.obstacle_range, p.raytrace_range, stamp_s)
+        kept = height_filter(pts, p.min_obstacle_height, p.max_obstacle_height)  # compiled
+        return Observation(origin, kept, p.obstacle_range, p.raytrace_range, stamp_s)
 
     def _purge(self) -> None:
         if not self.observations:

@@ -31,7 +31,13 @@ from numpy.typing import NDArray
 
 from roverlab.navigation.costmap.kernels import cells_cost, footprint_cells
 
-__all__ = ["first_known_stretch", "rollout", "score_rollouts", "target_distance"]
+__all__ = [
+    "first_known_stretch",
+    "rollout",
+    "score_rollouts",
+    "target_distance",
+    "target_distance_window",
+]
 
 _jit = numba.njit(cache=True, nogil=True)
 
@@ -52,27 +58,67 @@ def target_distance(
     neighbour): state 0 free and unseen, 1 an obstacle unseen, 2 seen (or the border).
     """
     h, w = costs.shape
+    target_distance_window(costs, seeds, out, np.array([0, 0, w - 1, h - 1], dtype=np.int64))
+
+
+@_jit
+def target_distance_window(
+    costs: NDArray[np.uint8],
+    seeds: NDArray[np.int64],
+    out: NDArray[np.float64],
+    window: NDArray[np.int64],
+) -> bool:
+    """:func:`target_distance` with the wave stopped as soon as every cell of ``window``
+    (``x0, y0, x1, y1``, cells, inclusive) has its final value: once every free cell and
+    seed of the window grown by one cell has been expanded (a free cell's distance is
+    final when the wave first reaches it, an obstacle cell's once each neighbour that can
+    reach it, free or a seed, is expanded).
+    Cells outside the window then hold the wave's values so far. Returns whether the wave
+    ran to its end (every cell final); with a window of the whole grid it always does.
+    """
+    h, w = costs.shape
     size = h * w
     pw = w + 2
     state = np.full((h + 2) * pw, 2, dtype=np.uint8)
     dist = np.full((h + 2) * pw, size + 1, dtype=np.int64)
+    # the window grown by one cell, clipped to the grid (bordered coordinates)
+    gx0 = max(window[0] - 1, 0) + 1
+    gy0 = max(window[1] - 1, 0) + 1
+    gx1 = min(window[2] + 1, w - 1) + 1
+    gy1 = min(window[3] + 1, h - 1) + 1
+    pending = 0
     for y in range(h):
         row = (y + 1) * pw + 1
+        inside_y = gy0 <= y + 1 <= gy1
         for x in range(w):
-            c = costs[y, x]
-            state[row + x] = 1 if c >= INSCRIBED else 0  # inscribed, lethal, unknown
+            if costs[y, x] >= INSCRIBED:  # inscribed, lethal, unknown
+                state[row + x] = 1
+            else:
+                state[row + x] = 0
+                if inside_y and gx0 <= x + 1 <= gx1:
+                    pending += 1
     queue = np.empty(size + seeds.shape[0], dtype=np.int64)
     qh = 0
     qt = 0
     for k in range(seeds.shape[0]):
-        idx = (seeds[k, 1] + 1) * pw + seeds[k, 0] + 1
+        sx = seeds[k, 0] + 1
+        sy = seeds[k, 1] + 1
+        idx = sy * pw + sx
+        if state[idx] == 1 and gy0 <= sy <= gy1 and gx0 <= sx <= gx1:
+            pending += 1  # a seed on an obstacle is expanded too (a free one is counted)
+        state[idx] = 3  # reached, to be expanded
         dist[idx] = 0
-        state[idx] = 2
         queue[qt] = idx
         qt += 1
-    while qh < qt:
+    while qh < qt and pending > 0:
         cur = queue[qh]
         qh += 1
+        if state[cur] == 3:
+            state[cur] = 2
+            cy = cur // pw
+            cx = cur - cy * pw
+            if gy0 <= cy <= gy1 and gx0 <= cx <= gx1:
+                pending -= 1
         d = dist[cur] + 1
         for nb in range(4):
             if nb == 0:
@@ -84,12 +130,13 @@ def target_distance(
             else:
                 n = cur + pw
             st = state[n]
-            if st == 2:
+            if st >= 2:
                 continue
-            state[n] = 2
             if st == 1:
+                state[n] = 2
                 dist[n] = size
                 continue
+            state[n] = 3  # reached, to be expanded
             dist[n] = d
             queue[qt] = n
             qt += 1
@@ -97,6 +144,7 @@ def target_distance(
         row = (y + 1) * pw + 1
         for x in range(w):
             out[y, x] = dist[row + x]
+    return qh >= qt
 
 
 @_jit
@@ -243,6 +291,15 @@ def _cell(w: int, h: int, res: float, ox: float, oy: float, x: float, y: float) 
     return mx, my
 
 
+#: :func:`_grid_critics`' answer to a read outside the window of final grid values
+OUTSIDE_WINDOW = -1000.0
+
+
+@_jit
+def _in_window(window: NDArray[np.int64], mx: int, my: int) -> bool:
+    return window[0] <= mx <= window[2] and window[1] <= my <= window[3]
+
+
 @_jit
 def _grid_critics(
     traj: NDArray[np.float64],
@@ -255,6 +312,7 @@ def _grid_critics(
     goal_grid: NDArray[np.float64],
     front_grid: NDArray[np.float64],
     scales: NDArray[np.float64],
+    window: NDArray[np.int64],
 ) -> tuple[float, float]:
     """Critics 3-6 of the module docstring over the first ``num`` poses of ``traj`` (x, y,
     th, cos th, sin th): ``(failure, cost)``, the failure (< 0) of the first critic that
@@ -265,6 +323,9 @@ def _grid_critics(
     different grids at the same points and fail only off the map, so one pass serves
     both; path and goal share the centres, and the path critic's failure, coming first,
     wins over the goal critic's at any point.
+
+    A grid read outside ``window`` (``x0, y0, x1, y1``: the cells whose values are final,
+    see :func:`target_distance_window`) returns :data:`OUTSIDE_WINDOW` at once.
     """
     h, w = path_grid.shape
     front_s, align_s, path_s, goal_s, fpd = scales[1], scales[2], scales[3], scales[4], scales[6]
@@ -279,6 +340,8 @@ def _grid_critics(
             mx, my = _cell(w, h, res, ox, oy, px, py)
             if mx < 0:
                 return -4.0, 0.0
+        if not _in_window(window, mx, my):
+            return OUTSIDE_WINDOW, 0.0
         front_v = front_grid[my, mx]
         align_v = path_grid[my, mx]
     path_v = 0.0
@@ -296,6 +359,8 @@ def _grid_critics(
                     return -4.0, 0.0
                 goal_fail = -4.0
                 break
+            if not _in_window(window, mx, my):
+                return OUTSIDE_WINDOW, 0.0
             if on_path:
                 v = path_grid[my, mx]
                 if v == size:
@@ -375,6 +440,7 @@ def score_rollouts(
     flags: NDArray[np.bool_],
     prune: bool,
     out: NDArray[np.float64],
+    window: NDArray[np.int64],
 ) -> int:
     """Score every velocity sample (the generation checks, then the critics of the module
     docstring), writing the total cost (``< 0``: rejected; -100: not generated) to ``out``.
@@ -402,9 +468,12 @@ def score_rollouts(
             up to ``max_scaling_factor`` from ``scaling_speed`` to ``max_vel_trans``).
         flags: oscillation ``forward_pos_only, forward_neg_only, strafe_pos_only,
             strafe_neg_only, rot_pos_only, rot_neg_only``.
+        window: the cells whose grid values are final (``x0, y0, x1, y1``, inclusive;
+            :func:`target_distance_window`).
 
     Returns:
-        The index of the best sample (first of equal costs), -1 if none is valid.
+        The index of the best sample (first of equal costs), -1 if none is valid, -2 if
+        a rollout read a grid outside ``window`` (nothing scored: widen the window).
     """
     h, w = costs.shape
     size = float(h * w)
@@ -440,8 +509,10 @@ def score_rollouts(
             out[k] = -6.0
             continue
         failed, total = _grid_critics(
-            traj, num, res, ox, oy, size, path_grid, goal_grid, front_grid, scales
+            traj, num, res, ox, oy, size, path_grid, goal_grid, front_grid, scales, window
         )
+        if failed == OUTSIDE_WINDOW:
+            return -2
         if failed < 0:
             out[k] = failed
             continue

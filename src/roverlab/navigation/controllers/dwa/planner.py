@@ -58,7 +58,7 @@ from roverlab.navigation.controllers.dwa.kernels import (
     first_known_stretch,
     rollout,
     score_rollouts,
-    target_distance,
+    target_distance_window,
 )
 from roverlab.navigation.controllers.dwa.params import DWAParams
 from roverlab.navigation.costmap.costmap_2d import (
@@ -171,6 +171,9 @@ class DWAPlanner(EscapeMixin):
         )
         self._prev_stationary = SE2()
         self._grids: tuple[NDArray[np.float64], ...] = ()
+        # the cells whose grid values are final (x0, y0, x1, y1) and the waves' seeds
+        self._window = np.zeros(4, dtype=np.int64)
+        self._seeds: tuple[NDArray[np.int64], ...] = ()
         self._scales = np.zeros(7)
 
     # ------------------------------------------------------------------ state
@@ -229,31 +232,29 @@ class DWAPlanner(EscapeMixin):
         p = self.params
         res = cm.resolution
         stretch = _first_known_stretch(plan, cm)
-        shape = (cm.size_y, cm.size_x)
-        path_grid = np.empty(shape)
-        goal_grid = np.empty(shape)
-        front_grid = np.empty(shape)
         if stretch is None:
             raise InvalidPathError(
                 "dwa_local_planner: none of the points of the global plan are in the local "
                 "costmap and free"
             )
-        target_distance(cm.costs, np.ascontiguousarray(stretch), path_grid)
-        # local goal: the last point of the plan's first stretch in the map
-        target_distance(cm.costs, np.ascontiguousarray(stretch[-1:]), goal_grid)
         g = plan[-1]
         ang = math.atan2(g[1] - pose.y, g[0] - pose.x)
         front = plan.copy()
         front[-1, 0] += p.forward_point_distance * math.cos(ang)
         front[-1, 1] += p.forward_point_distance * math.sin(ang)
         front_stretch = _first_known_stretch(front, cm)
-        if front_stretch is not None and (front_stretch[-1] == stretch[-1]).all():
-            front_grid[:] = goal_grid  # the same seed (the plan leaves the map before its end)
-        elif front_stretch is not None:
-            target_distance(cm.costs, np.ascontiguousarray(front_stretch[-1:]), front_grid)
+        # path grid, local goal grid (the last point of the plan's first stretch in the
+        # map), goal-front grid; the front seed empty: none (every cell unreachable);
+        # the same as the goal's (the plan leaves the map before its end): a copy
+        seeds = [np.ascontiguousarray(stretch), np.ascontiguousarray(stretch[-1:])]
+        if front_stretch is None:
+            seeds.append(np.zeros((0, 2), dtype=np.int64))
+        elif (front_stretch[-1] == stretch[-1]).all():
+            seeds.append(seeds[1])
         else:
-            front_grid[:] = cm.size_x * cm.size_y + 1
-        self._grids = (path_grid, goal_grid, front_grid)
+            seeds.append(np.ascontiguousarray(front_stretch[-1:]))
+        self._seeds = tuple(seeds)
+        self._waves(cm, self._reach_window(pose, cm))
         unit = res if p.meter_scoring else 1.0
         path_s = unit * p.path_distance_bias
         goal_s = unit * p.goal_distance_bias
@@ -271,6 +272,49 @@ class DWAPlanner(EscapeMixin):
             ]
         )
 
+    def _reach_window(self, pose: SE2, cm: Costmap2D) -> NDArray[np.int64]:
+        """The cells the critics read this cycle, as far as the parameters bound them: the
+        robot's cell +- the farthest a rollout gets in ``sim_time`` plus the look-ahead
+        point (a read outside it is caught by the scoring, which then has the waves run
+        to their end: the window affects the speed only, never a value read)."""
+        p = self.params
+        v = self._last_twist
+        vx = max(abs(p.max_vel_x), abs(p.min_vel_x), abs(p.escape_vel), abs(v.vx))
+        vy = max(abs(p.y_limits[0]), abs(p.y_limits[1]), abs(v.vy))
+        reach = max(p.max_vel_trans, math.hypot(vx, vy)) * p.sim_time
+        reach += max(p.forward_point_distance, p.heading_lookahead, 0.0)
+        r = math.ceil(reach / cm.resolution) + 2
+        cx = math.floor((pose.x - cm.origin_x) / cm.resolution)
+        cy = math.floor((pose.y - cm.origin_y) / cm.resolution)
+        return np.array([cx - r, cy - r, cx + r, cy + r], dtype=np.int64)
+
+    def _waves(self, cm: Costmap2D, window: NDArray[np.int64]) -> None:
+        """The three map grids (``MapGrid::computeTargetDistance`` from ``self._seeds``),
+        final within ``window`` (cells; the whole grid once every wave ran to its end)."""
+        shape = (cm.size_y, cm.size_x)
+        whole = np.array([0, 0, cm.size_x - 1, cm.size_y - 1], dtype=np.int64)
+        if window[0] <= 0 and window[1] <= 0 and window[2] >= whole[2] and window[3] >= whole[3]:
+            window = whole
+        complete = True
+        grids: list[NDArray[np.float64]] = []
+        for i, seeds in enumerate(self._seeds):
+            if i == 2 and seeds is self._seeds[1]:
+                grids.append(grids[1])  # the same wave (the grids are only read)
+            elif len(seeds) == 0:
+                grids.append(np.full(shape, float(cm.size_x * cm.size_y + 1)))
+            else:
+                grid = np.empty(shape)
+                complete &= target_distance_window(cm.costs, seeds, grid, window)
+                grids.append(grid)
+        self._grids = tuple(grids)
+        self._window = whole if complete else window
+
+    def _whole_grids(self, cm: Costmap2D) -> None:
+        """The waves run to their end (a read fell outside the window)."""
+        if not (self._window[0] <= 0 and self._window[1] <= 0 and self._window[2] >= cm.size_x - 1
+                and self._window[3] >= cm.size_y - 1):  # fmt: skip
+            self._waves(cm, np.array([0, 0, cm.size_x - 1, cm.size_y - 1], dtype=np.int64))
+
     # ------------------------------------------------------------------ scoring
     def _score(
         self, pose: SE2, vel: Velocity2D, samples: NDArray[np.float64], cm: Costmap2D,
@@ -283,15 +327,17 @@ class DWAPlanner(EscapeMixin):
              p.max_vel_trans, p.min_vel_theta, p.stop_time_buffer]
         )  # fmt: skip
         scaling = np.array([p.scaling_speed, p.max_vel_trans, p.max_scaling_factor])
-        best = score_rollouts(
-            np.ascontiguousarray(samples), pose.as_array(), vel.as_array(), gen,
-            np.array([p.acc_lim_x, p.acc_lim_y, p.acc_lim_theta]), not p.use_dwa,
-            cm.costs, cm.resolution, cm.origin_x, cm.origin_y, self._grids[0], self._grids[1],
-            self._grids[2], self.footprint if footprint is None else footprint, self._scales,
-            scaling, p.sum_scores, flags, prune,
-            out,
-        )  # fmt: skip
-        return int(best), out
+        while True:
+            best = score_rollouts(
+                np.ascontiguousarray(samples), pose.as_array(), vel.as_array(), gen,
+                np.array([p.acc_lim_x, p.acc_lim_y, p.acc_lim_theta]), not p.use_dwa,
+                cm.costs, cm.resolution, cm.origin_x, cm.origin_y, self._grids[0],
+                self._grids[1], self._grids[2], self.footprint if footprint is None else footprint,
+                self._scales, scaling, p.sum_scores, flags, prune, out, self._window,
+            )  # fmt: skip
+            if best != -2:
+                return int(best), out
+            self._whole_grids(cm)  # a rollout read past the window
 
     def _check(self, pose: SE2, vel: Velocity2D, cmd: NDArray[np.float64], cm: Costmap2D) -> bool:
         """DWAPlanner::checkTrajectory (the oscillation flags are reset, as ROS does)."""
@@ -326,7 +372,10 @@ class DWAPlanner(EscapeMixin):
         xs = velocity_iterator(lo[0], hi[0], nx)
         ys = velocity_iterator(lo[1], hi[1], ny)
         ths = velocity_iterator(lo[2], hi[2], nth)
-        grid = np.array(np.meshgrid(xs, ys, ths, indexing="ij")).reshape(3, -1).T
+        grid = np.empty((len(xs) * len(ys) * len(ths), 3))  # every (x, y, th), th fastest
+        grid[:, 0] = np.repeat(xs, len(ys) * len(ths))
+        grid[:, 1] = np.tile(np.repeat(ys, len(ths)), len(xs))
+        grid[:, 2] = np.tile(ths, len(xs) * len(ys))
         if rotations:  # TrajectoryPlanner's, whatever min_vel_x is
             grid = np.concatenate([grid, in_place_samples(lo[2], hi[2], nth, p.min_vel_theta)])
         return np.ascontiguousarray(grid, dtype=np.float64)
@@ -452,6 +501,7 @@ class DWAPlanner(EscapeMixin):
             )  # fmt: skip
             ends[k] = traj[num - 1] if num else pose.as_array()
         origin = (cm.resolution, cm.origin_x, cm.origin_y)
+        self._whole_grids(cm)  # the look-ahead cells of the ends may be past the window
         return self._rotations.pick(pose, samples, costs, ends, self._grids[1], origin)
 
     def _best(
