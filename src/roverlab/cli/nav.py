@@ -142,14 +142,12 @@ def _fixed(
             extra={"suite": suite},
         )  # fmt: skip
 
-    def pct(v: float | None) -> str:
-        return "-" if v is None else f"{100 * v:.0f} %"
-
     print(
         f"{summary['worlds']} worlds"
         + (f" ({summary['errors']} failed to run)" if summary["errors"] else "")
-        + f", {planner}: success {pct(summary['success_rate'])}, "
-        f"collisions {pct(summary['collision_rate'])}, timeouts {pct(summary['timeout_rate'])}"
+        + f", {planner}: success {percent(summary['success_rate'])}, "
+        f"collisions {percent(summary['collision_rate'])}, "
+        f"timeouts {percent(summary['timeout_rate'])}"
         + (f", score {summary['score_mean']:.3f}" if summary["score_mean"] is not None else "")
         + (f", control p99 max {summary['control_ms_p99_max']:.1f} ms"
            if summary["control_ms_p99_max"] is not None else "")
@@ -159,6 +157,19 @@ def _fixed(
     )  # fmt: skip
     if stop.is_set():
         raise typer.Exit(130)
+
+
+def percent(v: float | None) -> str:
+    """A rate as a percentage to 0.1, never rounded to 0 % or 100 % unless it is exactly
+    that (one failed world in 250 is not "100 %")."""
+    if v is None:
+        return "-"
+    p = 100.0 * v
+    if 0.0 < p < 0.05:
+        return "<0.1 %"
+    if 99.95 <= p < 100.0:
+        return ">99.9 %"
+    return f"{p:.1f} %"
 
 
 @app.command("bench")

@@ -91,6 +91,14 @@ def test_summary_rates_score_and_worst_control_cycle() -> None:
     assert s["rtf_per_cpu_s"] == pytest.approx(128.0 / 4.0)
 
 
+def test_the_summary_line_never_rounds_a_failure_away() -> None:
+    from roverlab.cli.nav import percent
+
+    assert percent(249 / 250) == "99.6 %" and percent(1 / 250) == "0.4 %"
+    assert percent(1.0) == "100.0 %" and percent(0.0) == "0.0 %" and percent(None) == "-"
+    assert percent(9999 / 10000) == ">99.9 %" and percent(1 / 10000) == "<0.1 %"
+
+
 def test_picture_grows_to_show_a_goal_off_the_map(tmp_path: Path) -> None:
     costs = np.zeros((20, 20), dtype=np.uint8)
     costs[0, :] = 254
