@@ -15,7 +15,7 @@ this process, and the episode's rules, score and files (``world_N.json/.csv/.png
 the move_base.
 
     scripts/build-ros1-navigation.sh /work/rosnav_ws
-    python benchmarks/barn_ros1_baseline.py --ws /work/rosnav_ws \\
+    python benchmarks/barn_ros1_baseline.py --ws /work/rosnav_ws --rate 2 \\
         --worlds /work/shared/data/barn/worlds --out runs/barn-ros1 --every 5
     python benchmarks/barn_ros1_baseline.py --out runs/barn-ros1 --compare runs/final2-dwa-0.5
 
@@ -391,8 +391,10 @@ def compare(ours: Path, theirs: Path) -> str:
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--ws", type=Path, default=Path("/work/rosnav_ws"),
-                    help="catkin workspace of scripts/build-ros1-navigation.sh")  # fmt: skip
+    ws = os.environ.get("ROS1_NAVIGATION_WS")
+    ap.add_argument("--ws", type=Path, default=Path(ws) if ws else None,
+                    help="catkin workspace of scripts/build-ros1-navigation.sh "
+                    "(default: $ROS1_NAVIGATION_WS)")  # fmt: skip
     ap.add_argument("--worlds", type=Path, default=Path("/work/shared/data/barn/worlds"))
     ap.add_argument("--params", type=Path, default=None, help="default: WORLDS/../params")
     ap.add_argument("--out", type=Path, required=True)
@@ -407,6 +409,9 @@ def main() -> int:
     if args.compare is not None:
         print(compare(args.out, args.compare))
         return 0
+    if args.ws is None:
+        print("error: give --ws WORKSPACE or set ROS1_NAVIGATION_WS", file=sys.stderr)
+        return 2
     move_base = args.ws / "devel" / "lib" / "move_base" / "move_base"
     if not move_base.is_file():
         print(f"error: {move_base}: not built (scripts/build-ros1-navigation.sh {args.ws})",
