@@ -39,6 +39,7 @@ import tempfile
 import threading
 import time
 import xmlrpc.client
+from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
@@ -352,9 +353,10 @@ def spread(ids: list[int], every: int) -> list[int]:
     return [ids[i] for off in range(every) for i in range(off, len(ids), every)]
 
 
-def compare(ours: Path, theirs: Path) -> str:
-    """A markdown table: real move_base (``ours``) vs roverlab's (``theirs``) on the
-    worlds both have, and the worlds where their outcomes differ."""
+def compare(ours: Path, others: list[Path]) -> str:
+    """A markdown table: real move_base (``ours``) vs roverlab's (each of ``others``, a
+    ``nav bench --suite barn`` output) on the worlds all have, and the worlds where the
+    real one's outcome differs from the first other's."""
 
     def load(d: Path) -> dict[str, dict[str, Any]]:
         out = {}
@@ -364,28 +366,45 @@ def compare(ours: Path, theirs: Path) -> str:
                 out[row["world"]] = row
         return out
 
-    a, b = load(ours), load(theirs)
-    common = sorted(set(a) & set(b), key=lambda w: int(w.split("_")[1]))
+    a = load(ours)
+    runs = [(f"roverlab ({d.name})", load(d)) for d in others]
+    common = set(a)
+    for _, rows in runs:
+        common &= set(rows)
+    worlds = sorted(common, key=lambda w: int(w.split("_")[1]))
     lines = [
-        f"Worlds: {len(common)}",
+        f"Worlds: {len(worlds)}",
         "",
-        "| move_base | success | collisions | timeouts | score mean | time mean (s) |",
-        "|---|---|---|---|---|---|",
+        "| move_base | worlds | success | collisions | timeouts | score mean | time mean |",
+        "|---|---|---|---|---|---|---|",
     ]
-    for label, rows in (("real C++ move_base (ROS 1, BARN's baseline)", a),
-                        (f"roverlab ({theirs.name})", b)):  # fmt: skip
-        sm = summarize([rows[w] for w in common])
+    for label, rows in [("real C++ move_base (ROS 1)", a), *runs]:
+        sm = summarize([rows[w] for w in worlds])
         lines.append(
-            f"| {label} | {sm['success_rate']:.1%} | {sm['collision_rate']:.1%} | "
-            f"{sm['timeout_rate']:.1%} | {sm['score_mean']:.3f} | {sm['time_mean_s']} |"
+            f"| {label} | {sm['worlds']} | {sm['success_rate']:.1%} | "
+            f"{sm['collision_rate']:.1%} | {sm['timeout_rate']:.1%} | "
+            f"{sm['score_mean']:.4f} | {sm['time_mean_s']:.1f} s |"
         )
-    diff = [w for w in common if a[w]["status"] != b[w]["status"]]
-    lines += ["", f"Outcomes differ in {len(diff)} worlds:"]
-    for w in diff:
-        lines.append(
-            f"- {w}: real {a[w]['status']} ({a[w]['move_base_status']}, {a[w]['time_s']} s), "
-            f"roverlab {b[w]['status']} ({b[w]['move_base_status']}, {b[w]['time_s']} s)"
-        )
+    if runs:
+        b = runs[0][1]
+        diff = [w for w in worlds if a[w]["status"] != b[w]["status"]]
+        lines += ["", f"Outcomes differ from {runs[0][0]} in {len(diff)} worlds:"]
+        for w in diff:
+            lines.append(
+                f"- {w}: real {a[w]['status']} ({a[w]['move_base_status']}, "
+                f"{a[w]['time_s']} s, {a[w]['text'] or '-'}), roverlab {b[w]['status']} "
+                f"({b[w]['move_base_status']}, {b[w]['time_s']} s)"
+            )
+        both = [w for w in worlds if a[w]["status"] == b[w]["status"] == "succeeded"]
+        if both:
+            ta = np.array([a[w]["time_s"] for w in both])
+            tb = np.array([b[w]["time_s"] for w in both])
+            lines.append(
+                f"\nBoth succeeded in {len(both)} worlds: time real/roverlab median "
+                f"{np.median(ta / tb):.2f}, real faster in {int((ta < tb - 0.5).sum())}, "
+                f"within 0.5 s in {int((abs(ta - tb) <= 0.5).sum())}, "
+                f"slower in {int((ta > tb + 0.5).sum())}."
+            )
     return "\n".join(lines)
 
 
@@ -403,8 +422,8 @@ def main() -> int:
     ap.add_argument("--limit", type=int, default=None, help="at most this many worlds")
     ap.add_argument("--only", type=str, default="", help="comma-separated world numbers")
     ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--compare", type=Path, default=None,
-                    help="print the table against this nav bench output; run nothing")  # fmt: skip
+    ap.add_argument("--compare", type=Path, action="append", default=None,
+                    help="print the table against this nav bench output (repeatable)")  # fmt: skip
     args = ap.parse_args()
     if args.compare is not None:
         print(compare(args.out, args.compare))
@@ -426,6 +445,7 @@ def main() -> int:
     ids = spread(ids, max(1, args.every))[: args.limit]
     args.out.mkdir(parents=True, exist_ok=True)
     rows = []
+    wall0 = time.perf_counter()
     for i, n in enumerate(ids):
         done = args.out / f"world_{n}.json"
         if not done.is_file():
@@ -453,10 +473,15 @@ def main() -> int:
             f"{': ' + row['text'] if row.get('text') else ''})",
             flush=True,
         )
+        planner = yaml.safe_load((params / "base_local_planner_params.yaml").read_text())
         summary = summarize(
-            rows, planner="move_base (C++, ROS 1): navfn + TrajectoryPlannerROS dwa:true",
-            robot="jackal", localization="odom", params=str(params), rate=args.rate,
-            seed=args.seed,
+            rows, date=datetime.now(UTC).strftime("%Y-%m-%d"),
+            planner="move_base (C++, ROS 1): navfn + TrajectoryPlannerROS dwa:true",
+            robot="jackal", localization="odom",
+            max_speed=planner["TrajectoryPlannerROS"].get("max_vel_x"), params=str(params),
+            launch=str(LAUNCH), seed=args.seed, workers=1, suite="barn", sim_rate=args.rate,
+            wall_s=round(time.perf_counter() - wall0, 2),
+            machine={"cpus": os.cpu_count(), "load_average": list(os.getloadavg())},
         )  # fmt: skip
         atomic_write_bytes(
             args.out / "summary.json", (json.dumps(summary, indent=1) + "\n").encode()
