@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -241,7 +242,10 @@ def test_jackal_teb_model_covers_the_padded_footprint_inside_and_out() -> None:
     gx, gy = np.meshgrid(np.linspace(lo[0], hi[0], 13), np.linspace(lo[1], hi[1], 11))
     dist = [robot_distance(0.0, 0.0, 0.0, fm.code, fm.as_array(), x, y)
             for x, y in zip(gx.ravel(), gy.ravel(), strict=True)]  # fmt: skip
-    assert max(dist) < params.min_obstacle_dist
+    # by half a cell at least: the band sees a post's cells as their centres, while the
+    # feasibility check rejects a pose whose outline crosses any part of a cell (the old
+    # line of +-0.1 m reached the padded corners with 2 mm to spare: BARN world_287)
+    assert max(dist) <= params.min_obstacle_dist - 0.5 * 0.05
     # at 2 m/s feasibility_check_no_poses 5 reaches 3 m ahead; the file checks 1 m
     assert params.feasibility_check_lookahead_distance == 1.0
 
@@ -270,6 +274,45 @@ def test_jackal_band_pushes_out_a_post_that_appears_inside_it() -> None:
     assert not inside.any(), poses[inside]
     length = float(np.sum(np.hypot(*np.diff(poses[:, :2], axis=0).T)))
     assert len(poses) < 40 and length < 5.0, (len(poses), length)
+
+
+# BARN world_287 at 0.5 m/s, the local costmap's lethal cells within 0.7 m of the robot
+# (cell indices of a 0.05 m grid), the robot's pose and every 4th point of navfn's plan
+_GAP_CELLS = [
+    (34, 69), (35, 69), (35, 70), (36, 68), (36, 69), (37, 69), (38, 69), (38, 70), (39, 68),
+    (39, 69), (39, 70), (40, 69), (41, 69), (41, 70), (42, 68), (42, 69), (43, 68), (43, 69),
+    (43, 71), (43, 72), (43, 91), (43, 92), (44, 69), (44, 70), (44, 72), (44, 73), (44, 90),
+    (44, 91), (45, 72), (45, 89), (45, 91), (46, 71), (46, 72), (46, 88), (46, 89), (46, 90),
+    (47, 72), (47, 73), (47, 87), (47, 88), (48, 72), (48, 88),
+]  # fmt: skip
+_GAP_PLAN = [
+    (1.98, 4.03), (2.1, 4.04), (2.2, 4.05), (2.29, 4.04), (2.39, 4.02), (2.49, 4.0),
+    (2.55, 4.07), (2.64, 4.12), (2.72, 4.18), (2.78, 4.25), (2.85, 4.33), (2.91, 4.41),
+    (2.96, 4.5), (3.01, 4.58), (3.08, 4.66), (3.15, 4.73), (3.22, 4.8), (3.29, 4.86),
+    (3.37, 4.92), (3.45, 4.99),
+]  # fmt: skip
+
+
+def test_jackal_band_turning_in_a_gap_keeps_the_padded_corners_off_the_posts() -> None:
+    """BARN world_287 at 0.5 m/s: the plan turns left just beyond a 0.65 m gap. With the
+    old model (a line of +-0.1 m, min_obstacle_dist 0.34) the optimised band began its
+    turn inside the gap, where the padded footprint's corners lie 0.338 m from the line
+    (2 mm inside the model): a corner's outline crossed a post cell 0.5 m ahead, every band
+    was "not feasible", and the robot stood still 9.5 s (44.1 s for the world; the same in
+    world_118, 122, 169 and 238, and for good in 64, 231 and 286). With the file's model
+    the band is feasible and the robot drives on at full speed."""
+    params = replace(_jackal(), max_vel_x=0.5, oscillation_recovery=False)
+    cm = Costmap2D(size_x=160, size_y=160, resolution=0.05)
+    for ix, iy in _GAP_CELLS:
+        cm.costs[iy, ix] = 254
+    plan = np.column_stack([np.array(_GAP_PLAN), np.zeros(len(_GAP_PLAN))])
+    pose = SE2(1.98, 4.012, 0.2665)
+    padded = pad_footprint(_BODY, 0.1)
+    cmd = TebPlanner(params, footprint=padded).compute_velocity(pose, Velocity2D(), plan, cm)
+    assert cmd.vx == pytest.approx(0.5)
+    old = replace(params, footprint_model=FootprintModel("line", (-0.1, 0.0, 0.1, 0.0)))
+    with pytest.raises(NoValidControlError, match="not feasible"):
+        TebPlanner(old, footprint=padded).compute_velocity(pose, Velocity2D(), plan, cm)
 
 
 def test_failure_detector_flags_a_robot_turning_back_and_forth() -> None:
