@@ -46,6 +46,7 @@ from typing import Any
 import numpy as np
 import yaml
 
+from roverlab.cli.common import stop_on_signals
 from roverlab.core import Context
 from roverlab.core.transport.ros1.transport import Ros1Transport
 from roverlab.fileio import atomic_write_bytes
@@ -444,50 +445,64 @@ def main() -> int:
         ids = [int(v) for v in args.only.split(",")]
     ids = spread(ids, max(1, args.every))[: args.limit]
     args.out.mkdir(parents=True, exist_ok=True)
-    rows = []
+    rows: list[dict[str, Any]] = []
     wall0 = time.perf_counter()
-    for i, n in enumerate(ids):
-        done = args.out / f"world_{n}.json"
-        if not done.is_file():
-            w, r = worlds[n]
-            try:
-                result, files, extra = run_world(
-                    n, w, r, params=params, ws_env=env, rate=args.rate, seed=args.seed,
-                    logdir=args.out,
-                )  # fmt: skip
-            except (RuntimeError, OSError) as err:
-                print(f"[{i + 1}/{len(ids)}] world_{n}: error: {err}", flush=True)
-                continue
-            row = result.to_json() | extra
-            files[f"world_{n}.json"] = (json.dumps(row, indent=1) + "\n").encode()
-            for fname, data in files.items():
-                atomic_write_bytes(args.out / fname, data)
-        row = json.loads(done.read_text())
-        row["episode"] = i
-        for key in ("path", "contact_points", "warnings", "start", "goal", "end"):
-            row.pop(key, None)
-        rows.append(row)
-        print(
-            f"[{i + 1}/{len(ids)}] {row['world']}: {row['status']} in {row['time_s']:.1f} s, "
-            f"score {row['score'] or 0:.3f} ({row['move_base_status']}"
-            f"{': ' + row['text'] if row.get('text') else ''})",
-            flush=True,
-        )
-        planner = yaml.safe_load((params / "base_local_planner_params.yaml").read_text())
-        summary = summarize(
-            rows, date=datetime.now(UTC).strftime("%Y-%m-%d"),
-            planner="move_base (C++, ROS 1): navfn + TrajectoryPlannerROS dwa:true",
-            robot="jackal", localization="odom",
-            max_speed=planner["TrajectoryPlannerROS"].get("max_vel_x"), params=str(params),
-            launch=str(LAUNCH), seed=args.seed, workers=1, suite="barn", sim_rate=args.rate,
-            wall_s=round(time.perf_counter() - wall0, 2),
-            machine={"cpus": os.cpu_count(), "load_average": list(os.getloadavg())},
-        )  # fmt: skip
-        atomic_write_bytes(
-            args.out / "summary.json", (json.dumps(summary, indent=1) + "\n").encode()
-        )
-        atomic_write_bytes(args.out / "worlds.csv", _csv(rows))
+    # SIGINT/SIGTERM/SIGHUP end the run after the world under way, its files and the
+    # summary written and its roscore, roslaunch and move_base stopped (a second SIGINT
+    # interrupts at once)
+    with stop_on_signals(threading.Event()) as stopping:
+        for i, n in enumerate(ids):
+            if stopping.is_set():
+                print(f"stopped after {len(rows)} worlds; resume with the same command")
+                return 130
+            run_one(i, n, ids, worlds, rows, args, params, env, wall0)
     return 0
+
+
+def run_one(
+    i: int, n: int, ids: list[int], worlds: dict[int, tuple[Path, Path | None]],
+    rows: list[dict[str, Any]], args: argparse.Namespace, params: Path,
+    env: dict[str, str], wall0: float,
+) -> None:  # fmt: skip
+    """Run world ``n`` unless its JSON is there, then rewrite the summary and table."""
+    done = args.out / f"world_{n}.json"
+    if not done.is_file():
+        w, r = worlds[n]
+        try:
+            result, files, extra = run_world(
+                n, w, r, params=params, ws_env=env, rate=args.rate, seed=args.seed,
+                logdir=args.out,
+            )  # fmt: skip
+        except (RuntimeError, OSError) as err:
+            print(f"[{i + 1}/{len(ids)}] world_{n}: error: {err}", flush=True)
+            return
+        row = result.to_json() | extra
+        files[f"world_{n}.json"] = (json.dumps(row, indent=1) + "\n").encode()
+        for fname, data in files.items():
+            atomic_write_bytes(args.out / fname, data)
+    row = json.loads(done.read_text())
+    row["episode"] = i
+    for key in ("path", "contact_points", "warnings", "start", "goal", "end"):
+        row.pop(key, None)
+    rows.append(row)
+    print(
+        f"[{i + 1}/{len(ids)}] {row['world']}: {row['status']} in {row['time_s']:.1f} s, "
+        f"score {row['score'] or 0:.3f} ({row['move_base_status']}"
+        f"{': ' + row['text'] if row.get('text') else ''})",
+        flush=True,
+    )
+    planner = yaml.safe_load((params / "base_local_planner_params.yaml").read_text())
+    summary = summarize(
+        rows, date=datetime.now(UTC).strftime("%Y-%m-%d"),
+        planner="move_base (C++, ROS 1): navfn + TrajectoryPlannerROS dwa:true",
+        robot="jackal", localization="odom",
+        max_speed=planner["TrajectoryPlannerROS"].get("max_vel_x"), params=str(params),
+        launch=str(LAUNCH), seed=args.seed, workers=1, suite="barn", sim_rate=args.rate,
+        wall_s=round(time.perf_counter() - wall0, 2),
+        machine={"cpus": os.cpu_count(), "load_average": list(os.getloadavg())},
+    )  # fmt: skip
+    atomic_write_bytes(args.out / "summary.json", (json.dumps(summary, indent=1) + "\n").encode())
+    atomic_write_bytes(args.out / "worlds.csv", _csv(rows))
 
 
 if __name__ == "__main__":
