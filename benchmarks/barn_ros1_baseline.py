@@ -51,13 +51,12 @@ from roverlab.core import Context
 from roverlab.core.transport.ros1.transport import Ros1Transport
 from roverlab.fileio import atomic_write_bytes
 from roverlab.navbench.fixed import (
-    BARN_OPTIMAL_SPEED_MPS,
     FixedResult,
     _draw_grid,
     _in_frame,
     _odom_origin,
-    barn_score,
     episode_files,
+    reference_score,
 )
 from roverlab.navbench.report import GoalRecord
 from roverlab.navbench.suite import (
@@ -298,15 +297,7 @@ def run_world(
         end = (s.x, s.y, s.yaw)
         elapsed = t_end - (st["t_start"] if st["t_start"] is not None else t_sent)
         reference = barn_reference(ref) if ref else None
-        ref_m = None
-        if reference is not None:
-            pts = np.asarray(reference, dtype=np.float64)
-            ref_m = float(np.hypot(*np.diff(pts, axis=0).T).sum())
-        score = (
-            barn_score(outcome == "succeeded", elapsed, ref_m / BARN_OPTIMAL_SPEED_MPS)
-            if ref_m
-            else None
-        )
+        ref_m, score = reference_score(outcome == "succeeded", elapsed, reference)
         rec = GoalRecord(
             index=0, start=start, goal=BARN_GOAL, status=mb_status, text=text,
             succeeded=outcome == "succeeded", time_s=elapsed, driven_m=driven,

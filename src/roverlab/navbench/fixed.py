@@ -19,7 +19,7 @@ import json
 import math
 import tempfile
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -72,6 +72,20 @@ def barn_score(success: bool, time_s: float, optimal_time_s: float) -> float:
     if not success or not optimal_time_s > 0:
         return 0.0
     return optimal_time_s / float(np.clip(time_s, 2 * optimal_time_s, 8 * optimal_time_s))
+
+
+def reference_score(
+    success: bool, time_s: float, reference: Sequence[tuple[float, float]] | None
+) -> tuple[float | None, float | None]:
+    """The reference path's length (m) and BARN's score against it (at 2 m/s), or
+    ``(None, None)`` without a reference."""
+    if reference is None:
+        return None, None
+    pts = np.asarray(reference, dtype=np.float64)
+    ref_m = float(np.hypot(*np.diff(pts, axis=0).T).sum())
+    if not ref_m:
+        return ref_m, None
+    return ref_m, barn_score(success, time_s, ref_m / BARN_OPTIMAL_SPEED_MPS)
 
 
 @dataclass(frozen=True)
@@ -398,15 +412,7 @@ class _Episode:
         driven = float(np.hypot(*np.diff(xy, axis=0).T).sum()) if len(xy) > 1 else 0.0
         end = (s.x, s.y, s.yaw)
         elapsed = t_end - (self.t_start if self.t_start is not None else self._t_sent)
-        ref = None
-        if cfg.reference is not None:
-            pts = np.asarray(cfg.reference, dtype=np.float64)
-            ref = float(np.hypot(*np.diff(pts, axis=0).T).sum())
-        score = (
-            barn_score(outcome == "succeeded", elapsed, ref / BARN_OPTIMAL_SPEED_MPS)
-            if ref
-            else None
-        )
+        ref, score = reference_score(outcome == "succeeded", elapsed, cfg.reference)
         rec = GoalRecord(
             index=0, start=start, goal=cfg.goal, status=mb_status, text=text,
             succeeded=outcome == "succeeded", time_s=elapsed, driven_m=driven,
