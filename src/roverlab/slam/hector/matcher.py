@@ -98,6 +98,23 @@ def _cost(
     points: NDArray[np.float64],
 ) -> float:
     """``sum (1 - M)^2`` at the map-coordinate pose ``(mx, my, theta)`` of one level."""
+    return _cost_below(prob, off, size, k, mx, my, theta, points, np.inf)
+
+
+@_jit
+def _cost_below(
+    prob: NDArray[np.float32],
+    off: int,
+    size: int,
+    k: float,
+    mx: float,
+    my: float,
+    theta: float,
+    points: NDArray[np.float64],
+    bound: float,
+) -> float:
+    """:func:`_cost`, abandoned (returning a value >= ``bound``) once it reaches ``bound``:
+    a search over many poses skips the rest of a pose already worse than its best."""
     c = math.cos(theta)
     s = math.sin(theta)
     total = 0.0
@@ -106,6 +123,8 @@ def _cost(
         py = points[j, 1] * k
         v, _, _ = _interp(prob, off, size, mx + c * px - s * py, my + s * px + c * py)
         total += (1.0 - v) * (1.0 - v)
+        if total >= bound:
+            break
     return total
 
 

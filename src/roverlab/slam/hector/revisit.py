@@ -34,7 +34,7 @@ from roverlab.geometry import SE2, wrap_angle
 from roverlab.slam.degeneracy import odometry_along, scan_constraint
 from roverlab.slam.hector.degeneracy import map_values
 from roverlab.slam.hector.grid import MultiResGrid
-from roverlab.slam.hector.matcher import _cost, _interp, match
+from roverlab.slam.hector.matcher import _cost, _cost_below, match
 from roverlab.slam.hector.params import HectorParams
 
 __all__ = ["OCCUPIED_ABOVE", "SEARCH_EVERY", "Revisit", "differs", "wide_search"]
@@ -77,24 +77,12 @@ def _wide_search(
     best[1] = mx
     best[2] = my
     best[3] = theta
-    n = points.shape[0]
     for qa in range(-turns, turns + 1):
         t = theta + qa * turn_step
-        c = math.cos(t)
-        s = math.sin(t)
         for qx in range(-cells, cells + 1):
             for qy in range(-cells, cells + 1):
                 # hector's cost, abandoned once it exceeds the best so far
-                total = 0.0
-                for j in range(n):
-                    px = points[j, 0] * k
-                    py = points[j, 1] * k
-                    v, _, _ = _interp(
-                        prob, off, size, mx + qx + c * px - s * py, my + qy + s * px + c * py
-                    )
-                    total += (1.0 - v) * (1.0 - v)
-                    if total >= best[0]:
-                        break
+                total = _cost_below(prob, off, size, k, mx + qx, my + qy, t, points, best[0])
                 if total < best[0]:
                     best[0] = total
                     best[1] = mx + qx
