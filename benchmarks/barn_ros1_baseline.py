@@ -16,7 +16,7 @@ the move_base.
 
     scripts/build-ros1-navigation.sh /work/rosnav_ws
     python benchmarks/barn_ros1_baseline.py --ws /work/rosnav_ws --rate 2 \\
-        --worlds /work/shared/data/barn/worlds --out runs/barn-ros1 --every 5
+        --worlds ../shared/data/barn/worlds --out runs/barn-ros1 --every 5
     python benchmarks/barn_ros1_baseline.py --out runs/barn-ros1 --compare runs/final2-dwa-0.5
 
 A world whose JSON is already in ``--out`` is skipped, so a run can be resumed. With
@@ -80,6 +80,9 @@ GOAL_TOLERANCE_M = 1.0
 TIME_LIMIT_S = 100.0
 START_MOVE_M = 0.1
 SYSTEM_PATH = "/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin"
+
+#: ../shared/data/barn/worlds beside the repository (the project's data folder)
+BARN_WORLDS = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "barn" / "worlds"
 
 
 def ros_env(ws: Path) -> dict[str, str]:
@@ -406,7 +409,7 @@ def main() -> int:
     ap.add_argument("--ws", type=Path, default=Path(ws) if ws else None,
                     help="catkin workspace of scripts/build-ros1-navigation.sh "
                     "(default: $ROS1_NAVIGATION_WS)")  # fmt: skip
-    ap.add_argument("--worlds", type=Path, default=Path("/work/shared/data/barn/worlds"))
+    ap.add_argument("--worlds", type=Path, default=BARN_WORLDS)
     ap.add_argument("--params", type=Path, default=None, help="default: WORLDS/../params")
     ap.add_argument("--out", type=Path, required=True)
     ap.add_argument("--rate", type=float, default=1.0, help="sim seconds per wall second")
