@@ -47,6 +47,21 @@ class EscapeMixin:
     ) -> tuple[int, NDArray[np.float64]]:  # fmt: skip
         raise NotImplementedError
 
+    def _roll(
+        self, pose: SE2, vel: Velocity2D, cmd: NDArray[np.float64], continued: bool | None = None
+    ) -> NDArray[np.float64]:
+        """The poses (k, 3) of ``cmd`` from ``pose`` at ``vel`` over ``sim_time``, as the
+        scoring rolls a sample out (``continued`` acceleration: TrajectoryPlanner's, i.e.
+        not ``dwa``, unless given); empty when the rollout has no step."""
+        p = self.params
+        traj = np.empty((int(p.sim_time / min(p.sim_granularity, 1.0)) * 4 + 64, 3))
+        num, _, _ = rollout(
+            pose.as_array(), vel.as_array(), cmd, p.sim_time, p.sim_granularity,
+            p.angular_sim_granularity, (not p.use_dwa) if continued is None else continued,
+            np.array([p.acc_lim_x, p.acc_lim_y, p.acc_lim_theta]), 0.0, traj,
+        )  # fmt: skip
+        return traj[:num]
+
     def _escape(
         self, pose: SE2, vel: Velocity2D, samples: NDArray[np.float64], cm: Costmap2D,
         costs: NDArray[np.float64],
@@ -63,7 +78,6 @@ class EscapeMixin:
         fp = self.footprint
         if len(fp) < 3:
             return -1, costs
-        p = self.params
         w, h = cm.size_x, cm.size_y
         buf = np.empty((len(fp) + 1) * 2 * (w + h + 2), dtype=np.int64)
         args = (w, h, cm.resolution, cm.origin_x, cm.origin_y)
@@ -77,19 +91,14 @@ class EscapeMixin:
         best, rcosts = self._score(pose, vel, samples, relaxed, self._only, prune=False)
         if best < 0:
             return -1, costs
-        acc = np.array([p.acc_lim_x, p.acc_lim_y, p.acc_lim_theta])
-        traj = np.empty((int(p.sim_time / min(p.sim_granularity, 1.0)) * 4 + 64, 3))
         line = np.empty((w + h + 4, 2), dtype=np.int64)
         for k in np.argsort(np.where(rcosts >= 0, rcosts, np.inf), kind="stable"):
             if rcosts[k] < 0:
                 break
-            num, _, _ = rollout(
-                pose.as_array(), vel.as_array(), samples[k], p.sim_time, p.sim_granularity,
-                p.angular_sim_granularity, not p.use_dwa, acc, 0.0, traj,
-            )  # fmt: skip
-            if num == 0:
+            traj = self._roll(pose, vel, samples[k])
+            if len(traj) == 0:
                 continue
-            x, y, th = (float(v) for v in traj[num - 1])
+            x, y, th = (float(v) for v in traj[-1])
             m = outline_cells(*args, x, y, th, fp, buf)
             if np.isin(buf[:m], stuck).any():
                 continue
@@ -108,11 +117,8 @@ class EscapeMixin:
         with each of :meth:`_escape_footprints` in turn that is clear where the robot
         stands, until one gives a sample."""
         fp = self.footprint
-        p = self.params
         args = (cm.resolution, cm.origin_x, cm.origin_y)
         line = np.empty((cm.size_x + cm.size_y + 4, 2), dtype=np.int64)
-        acc = np.array([p.acc_lim_x, p.acc_lim_y, p.acc_lim_theta])
-        traj = np.empty((int(p.sim_time / min(p.sim_granularity, 1.0)) * 4 + 64, 3))
         for body in self._escape_footprints():
             if len(body) < 3 or (body.shape == fp.shape and np.array_equal(body, fp)):
                 return -1, costs
@@ -122,12 +128,11 @@ class EscapeMixin:
             for k in np.argsort(np.where(bcosts >= 0, bcosts, np.inf), kind="stable"):
                 if bcosts[k] < 0:
                     break
-                num, _, _ = rollout(
-                    pose.as_array(), vel.as_array(), samples[k], p.sim_time, p.sim_granularity,
-                    p.angular_sim_granularity, not p.use_dwa, acc, 0.0, traj,
-                )  # fmt: skip
-                x, y, th = (float(v) for v in traj[max(num - 1, 0)])
-                if num and footprint_cost(cm.costs, *args, x, y, th, fp, 1.0, line) >= 0:
+                traj = self._roll(pose, vel, samples[k])
+                if len(traj) == 0:
+                    continue
+                x, y, th = (float(v) for v in traj[-1])
+                if footprint_cost(cm.costs, *args, x, y, th, fp, 1.0, line) >= 0:
                     return int(k), bcosts
         return -1, costs
 
@@ -165,24 +170,18 @@ class EscapeMixin:
         p = self.params
         if p.escape_vel >= 0.0:
             return None
-        cmd = np.array([p.escape_vel, 0.0, 0.0])
-        acc = np.array([p.acc_lim_x, p.acc_lim_y, p.acc_lim_theta])
-        traj = np.empty((int(p.sim_time / min(p.sim_granularity, 1.0)) * 4 + 64, 3))
-        num, _, _ = rollout(
-            pose.as_array(), twist.as_array(), cmd, p.sim_time, p.sim_granularity,
-            p.angular_sim_granularity, True, acc, 0.0, traj,
-        )  # fmt: skip
+        traj = self._roll(pose, twist, np.array([p.escape_vel, 0.0, 0.0]), continued=True)
         need = min(p.escape_reset_dist, abs(p.escape_vel) * p.sim_time)
         line = np.empty((cm.size_x + cm.size_y + 4, 2), dtype=np.int64)
         for body in self._escape_footprints():
-            if self._clear_backing(pose, traj[:num], need, body, cm, line):
+            if self._clear_backing(pose, traj, need, body, cm, line):
                 break
         else:
             return None
         if not self.escaping:
             self.escaping = True
             self._escape_from = pose
-        self.trajectory = traj[:num].copy()
+        self.trajectory = traj.copy()
         vx = max(p.escape_vel, twist.vx - p.acc_lim_x * p.sim_period)
         return Velocity2D(vx, 0.0, 0.0)
 

@@ -56,7 +56,6 @@ from roverlab.navigation.controllers.dwa.in_place import (
 )
 from roverlab.navigation.controllers.dwa.kernels import (
     first_known_stretch,
-    rollout,
     score_rollouts,
     target_distance_window,
 )
@@ -475,13 +474,7 @@ class DWAPlanner(EscapeMixin):
             )
         cmd = samples[best]
         self._update_oscillation(pose, cmd)
-        traj = np.empty((int(p.sim_time / min(p.sim_granularity, 1.0)) * 4 + 64, 3))
-        n, _, _ = rollout(
-            pose.as_array(), twist.as_array(), cmd, p.sim_time, p.sim_granularity,
-            p.angular_sim_granularity, not p.use_dwa,
-            np.array([p.acc_lim_x, p.acc_lim_y, p.acc_lim_theta]), 0.0, traj,
-        )  # fmt: skip
-        self.trajectory = traj[:n].copy()
+        self.trajectory = self._roll(pose, twist, cmd).copy()
         return Velocity2D(float(cmd[0]), float(cmd[1]), float(cmd[2]))
 
     def _pick_in_place(
@@ -490,16 +483,10 @@ class DWAPlanner(EscapeMixin):
     ) -> int:  # fmt: skip
         """TrajectoryPlanner's choice between the best sample and its rotations in place
         (:class:`.in_place.InPlaceRotations`), from the rotations' end poses."""
-        p = self.params
         ends = np.zeros((len(samples), 3))
-        acc = np.array([p.acc_lim_x, p.acc_lim_y, p.acc_lim_theta])
-        traj = np.empty((int(p.sim_time / min(p.sim_granularity, 1.0)) * 4 + 64, 3))
         for k in np.flatnonzero((samples[:, 0] == 0.0) & (costs >= 0)):
-            num, _, _ = rollout(
-                pose.as_array(), vel.as_array(), samples[k], p.sim_time, p.sim_granularity,
-                p.angular_sim_granularity, not p.use_dwa, acc, 0.0, traj,
-            )  # fmt: skip
-            ends[k] = traj[num - 1] if num else pose.as_array()
+            traj = self._roll(pose, vel, samples[k])
+            ends[k] = traj[-1] if len(traj) else pose.as_array()
         origin = (cm.resolution, cm.origin_x, cm.origin_y)
         self._whole_grids(cm)  # the look-ahead cells of the ends may be past the window
         return self._rotations.pick(pose, samples, costs, ends, self._grids[1], origin)
