@@ -25,6 +25,10 @@ def execute(goal):
     while feedback.get_num_connections() == 0 and time.monotonic() < end:
         time.sleep(0.02)
     server.publish_feedback(MoveBaseFeedback(base_position=pose))
+    # feedback and result travel on two TCPROS links, so a result published at once can
+    # overtake the feedback and end the client's wait first; a real move_base sends
+    # feedback for the whole drive before its result
+    time.sleep(0.3)
     if pose.pose.position.x < 0:
         server.set_aborted(MoveBaseResult(), "negative x")
     else:
