@@ -334,3 +334,41 @@ def test_seeded_runs_are_identical() -> None:
         return [status, ctx.now()]
 
     assert run() == run()
+
+
+def test_feedback_and_status_copies_match_the_factory_built_messages(ctx: Context) -> None:
+    """The server builds feedback and status snapshots with the rosbags classes directly:
+    the same bytes (and field types) as the factory-built messages they replaced."""
+    from roverlab.actionlib import server as srv
+    from roverlab.msgs.cdr import serialize
+
+    fib = FibServer(ctx)
+    client = SimpleActionClient(ctx.create_node("client"), "fibonacci", FIB)
+    assert client.wait_for_server(timeout=5.0)
+    seen: list[tuple[Any, int]] = []
+    ctx.create_node("fb_echo").create_subscription(
+        "actionlib_tutorials/FibonacciActionFeedback",
+        "/fibonacci/feedback",
+        lambda m: seen.append((m, ctx.executor.now_ns)),
+        100,
+    )
+    client.send_goal({"order": 3})
+    assert client.wait_for_result(timeout=10.0)
+    assert len(seen) == 3
+    spec = fib.server.spec
+    for msg, now_ns in seen:
+        plain = spec.ActionFeedback()
+        plain.header.stamp = Time(now_ns).to_msg()
+        plain.status = srv.GoalStatusMsg(
+            goal_id=srv.GoalID(stamp=msg.status.goal_id.stamp, id=msg.status.goal_id.id),
+            status=int(msg.status.status),
+            text=str(msg.status.text),
+        )
+        plain.feedback = spec.Feedback.from_dict({"sequence": list(msg.feedback.sequence)})
+        assert serialize(msg) == serialize(plain)
+        assert type(msg.status.status) is int and type(msg.header.frame_id) is str
+    tracker = srv.GoalStatusMsg(
+        goal_id=srv.GoalID(stamp=Time(7).to_msg(), id="g"), status=GoalStatus.ACTIVE, text="t"
+    )
+    copy = srv._copy_status(tracker)
+    assert copy == tracker and copy is not tracker and copy.goal_id is not tracker.goal_id

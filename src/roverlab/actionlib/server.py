@@ -27,6 +27,9 @@ __all__ = ["ActionServer", "ServerGoalHandle"]
 
 GoalID = get_factory("actionlib_msgs/msg/GoalID")
 GoalStatusMsg = get_factory("actionlib_msgs/msg/GoalStatus")
+_Header = get_factory("std_msgs/msg/Header")
+_GoalIDCls = GoalID.cls
+_GoalStatusCls = GoalStatusMsg.cls
 GoalStatusArray = get_factory("actionlib_msgs/msg/GoalStatusArray")
 
 _LATCHED = QoSProfile(depth=1, durability="transient_local")
@@ -299,10 +302,13 @@ class ActionServer:
 
     def _publish_feedback(self, status: Any, feedback: Any) -> None:
         with self.lock:
-            msg = self.spec.ActionFeedback()
-            msg.header.stamp = self._now().to_msg()
-            msg.status = _copy_status(status)
-            msg.feedback = _as_message(feedback, self.spec.Feedback)
+            # the rosbags class directly (a move_base cycle sends one): the fields the
+            # factory's defaults and three assignments would give, without the defaults
+            msg = self.spec.ActionFeedback.cls(
+                header=_Header.cls(stamp=self._now().to_msg(), frame_id=""),
+                status=_copy_status(status),
+                feedback=_as_message(feedback, self.spec.Feedback),
+            )
             if self.started:
                 self._feedback_pub.publish(msg)
 
@@ -371,9 +377,15 @@ class ActionServer:
 
 
 def _copy_status(status: Any) -> Any:
-    """A snapshot of a tracker's status (messages are passed by reference in process)."""
-    return GoalStatusMsg(
-        goal_id=GoalID(stamp=status.goal_id.stamp, id=status.goal_id.id),
+    """A snapshot of a tracker's status (messages are passed by reference in process).
+
+    Built with the rosbags classes directly: the tracker's fields were checked when it
+    was made, so the factory's checks would only repeat them (this runs for every
+    feedback and every status entry of every status message).
+    """
+    gid = status.goal_id
+    return _GoalStatusCls(
+        goal_id=_GoalIDCls(stamp=gid.stamp, id=str(gid.id)),
         status=int(status.status),
         text=str(status.text),
     )
