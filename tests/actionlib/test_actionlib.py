@@ -334,3 +334,65 @@ def test_seeded_runs_are_identical() -> None:
         return [status, ctx.now()]
 
     assert run() == run()
+
+
+def test_feedback_and_status_copies_match_the_factory_built_messages(ctx: Context) -> None:
+    """The server builds feedback and status snapshots with the rosbags classes directly:
+    the same bytes (and field types) as the factory-built messages they replaced."""
+    from roverlab.actionlib import server as srv
+    from roverlab.msgs.cdr import serialize
+
+    fib = FibServer(ctx)
+    client = SimpleActionClient(ctx.create_node("client"), "fibonacci", FIB)
+    assert client.wait_for_server(timeout=5.0)
+    seen: list[tuple[Any, int]] = []
+    ctx.create_node("fb_echo").create_subscription(
+        "actionlib_tutorials/FibonacciActionFeedback",
+        "/fibonacci/feedback",
+        lambda m: seen.append((m, ctx.executor.now_ns)),
+        100,
+    )
+    client.send_goal({"order": 3})
+    assert client.wait_for_result(timeout=10.0)
+    assert len(seen) == 3
+    spec = fib.server.spec
+    for msg, now_ns in seen:
+        plain = spec.ActionFeedback()
+        plain.header.stamp = Time(now_ns).to_msg()
+        plain.status = srv.GoalStatusMsg(
+            goal_id=srv.GoalID(stamp=msg.status.goal_id.stamp, id=msg.status.goal_id.id),
+            status=int(msg.status.status),
+            text=str(msg.status.text),
+        )
+        plain.feedback = spec.Feedback.from_dict({"sequence": list(msg.feedback.sequence)})
+        assert serialize(msg) == serialize(plain)
+        assert type(msg.status.status) is int and type(msg.header.frame_id) is str
+    tracker = srv.GoalStatusMsg(
+        goal_id=srv.GoalID(stamp=Time(7).to_msg(), id="g"), status=GoalStatus.ACTIVE, text="t"
+    )
+    copy = srv._copy_status(tracker)
+    assert copy == tracker and copy is not tracker and copy.goal_id is not tracker.goal_id
+
+
+def test_a_feedback_dict_of_messages_is_what_from_dict_makes() -> None:
+    """``{"base_position": PoseStamped}`` (move_base's feedback) is built directly: the
+    same message as ``from_dict`` (the value kept, not copied); other dicts go through
+    ``from_dict`` with its checks."""
+    from roverlab.actionlib import server as srv
+    from roverlab.msgs import get_factory
+    from roverlab.msgs.cdr import serialize
+
+    feedback = get_factory("move_base_msgs/msg/MoveBaseFeedback")
+    pose = get_factory("geometry_msgs/msg/PoseStamped")(
+        header={"frame_id": "map", "stamp": {"sec": 3}}, pose={"position": {"x": 1.5}}
+    )
+    fast = srv._as_message({"base_position": pose}, feedback)
+    plain = feedback.from_dict({"base_position": pose})
+    assert type(fast) is type(plain) and serialize(fast) == serialize(plain)
+    assert fast.base_position is pose
+    nested = srv._as_message({"base_position": {"pose": {"position": {"y": 2.0}}}}, feedback)
+    assert nested.base_position.pose.position.y == 2.0
+    with pytest.raises(Exception, match="base_positon"):
+        srv._as_message({"base_positon": pose}, feedback)
+    with pytest.raises(Exception):  # noqa: B017 - a Twist is no PoseStamped: from_dict refuses
+        srv._as_message({"base_position": get_factory("geometry_msgs/msg/Twist")()}, feedback)

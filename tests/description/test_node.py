@@ -13,6 +13,7 @@ from roverlab.core import Context, ParameterError, Time
 from roverlab.description import DescriptionError, load_robot
 from roverlab.description.node import JointStatePublisher, RobotStatePublisher
 from roverlab.msgs import Header, JointState, String
+from roverlab.msgs.cdr import serialize
 from roverlab.tf import Buffer, TransformListener
 from tests.description.conftest import MYBOT_XACRO, MYCAR_XACRO, robot
 
@@ -225,6 +226,19 @@ def test_joint_state_publisher_defaults_and_sources() -> None:
     assert list(last.position) == pytest.approx([1.0, 0.4, 0.8])
     assert list(last.velocity) == pytest.approx([0.0, 1.0, 0.0])
     assert jsp.positions() == pytest.approx({"lift": 1.0, "spin": 0.4, "twin": 0.8})
+    # the builder-made message is the factory-made one (values, dtypes, bytes)
+    fast = jsp.message()
+    names = [j.name for j in jsp.joints]
+    plain = JointState(
+        header=Header(stamp=ctx.now().to_msg()),
+        name=names,
+        position=[jsp.positions()[n] for n in names],
+        velocity=[jsp._velocities.get(n, 0.0) for n in names],
+        effort=[],
+    )
+    assert serialize(fast) == serialize(plain)
+    for field in ("position", "velocity", "effort"):
+        assert getattr(fast, field).dtype == getattr(plain, field).dtype == np.float64
     ctx.shutdown()
 
 

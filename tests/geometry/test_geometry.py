@@ -70,3 +70,14 @@ def test_transform3_matches_se2_and_inverts() -> None:
     half = Transform3().interpolate(Transform3.from_se2(SE2(2.0, 0.0, 1.0)), 0.5)
     assert half.translation == pytest.approx((1.0, 0.0, 0.0))
     assert half.yaw == pytest.approx(0.5)
+
+
+def test_yaw_from_quat_of_a_tuple_matches_the_array_path() -> None:
+    """A tuple (a Transform3's rotation) skips numpy: the same yaw, bit for bit."""
+    rng = np.random.default_rng(3)
+    for _ in range(200):
+        q = rng.normal(size=4)
+        q /= np.linalg.norm(q)
+        as_tuple = tuple(float(v) for v in q)
+        assert yaw_from_quat(as_tuple) == yaw_from_quat(q) == yaw_from_quat(list(as_tuple))
+    assert yaw_from_quat((0, 0, 0, 1)) == 0.0

@@ -92,3 +92,38 @@ def test_joint_state_and_laser_scan() -> None:
     )
     got = build.laser_scan(1, 2, "laser", -1.0, 1.0, 0.2, 0.0, 0.1, 0.05, 12.0, ranges, empty)
     _same(got, ref_scan)
+
+
+def test_a_deferred_laser_scan_is_the_laser_scan_once_read() -> None:
+    """``laser_scan_later``: ``ranges`` made on first read (once), then a LaserScan in
+    every way but its class: fields, bytes (CDR and ROS 1), a copy or pickle is plain."""
+    import copy
+    import pickle
+
+    from roverlab.msgs.ros1 import serialize_ros1
+
+    ranges = np.arange(10, dtype=np.float32)
+    empty = np.zeros(0, dtype=np.float32)
+    calls: list[int] = []
+
+    def make() -> Any:
+        calls.append(1)
+        return ranges
+
+    args = (1, 2, "laser", -1.0, 1.0, 0.2, 0.0, 0.1, 0.05, 12.0)
+    got = build.laser_scan_later(*args, make, empty)
+    ref = build.laser_scan(*args, ranges, empty)
+    assert not calls and isinstance(got, mc.LaserScan) and got.__msgtype__ == ref.__msgtype__
+    assert got.ranges is ranges and got.ranges is ranges and len(calls) == 1
+    for f in dataclasses.fields(ref):
+        assert getattr(got, f.name) is getattr(ref, f.name) or (
+            getattr(got, f.name) == getattr(ref, f.name)
+        )
+    assert serialize(got) == serialize(ref)
+    assert serialize_ros1(got) == serialize_ros1(ref)
+    for twin in (copy.copy(got), pickle.loads(pickle.dumps(got))):
+        assert type(twin) is mc.LaserScan and serialize(twin) == serialize(ref)
+    unread = build.laser_scan_later(*args, make, empty)
+    assert serialize(pickle.loads(pickle.dumps(unread))) == serialize(ref)
+    unread.ranges = np.zeros(3, dtype=np.float32)  # a reader may replace the field
+    assert list(unread.ranges) == [0.0, 0.0, 0.0] and len(calls) == 2

@@ -101,3 +101,29 @@ def test_camera_reuses_only_images_nobody_holds() -> None:
     rgb, _ = model.capture(scene, 0, 0, 0.2, 1.0)
     np.testing.assert_array_equal(fourth, rgb)
     np.testing.assert_array_equal(first, model.capture(scene, 0, 0, 0.2, 0.0)[0])
+
+
+def test_deferred_scans_are_the_scans_read_in_any_order_and_thread() -> None:
+    """``scan_later`` draws the noise at once and casts when asked: read late, out of
+    order, twice or in another thread, each gives what ``scan`` gave at that pose."""
+    import threading
+
+    scene = Scene(
+        segments=[[-2, -2, 2, -2], [2, -2, 2, 2], [2, 2, -2, 2], [-2, 2, -2, -2]],
+        circles=[[0.8, 0.4, 0.15], [-0.5, 1.1, 0.15]],
+    )
+    params = LidarParams(720, -2.35, 2.35, 0.1, 3.0, 0.0, 0.01, 0.01)
+    eager = LidarModel(params, np.random.default_rng(4))
+    lazy = LidarModel(params, np.random.default_rng(4))
+    poses = [(0.1 * k - 1.0, 0.05 * k - 0.5, 0.2, 0.3 * k) for k in range(140)]  # > 2 blocks
+    want = [eager.scan(scene, *p) for p in poses]
+    later = [lazy.scan_later(scene, *p) for p in poses]
+    for k in reversed(range(len(poses))):
+        np.testing.assert_array_equal(later[k](), want[k])
+    got: list[Any] = []
+    worker = threading.Thread(target=lambda: got.append(later[7]()))
+    worker.start()
+    worker.join()
+    np.testing.assert_array_equal(got[0], want[7])
+    with pytest.raises(Exception, match="lidar pose must be finite"):
+        lazy.scan_later(scene, math.nan, 0.0, 0.2, 0.0)

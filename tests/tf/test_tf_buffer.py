@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 import pytest
@@ -12,6 +13,7 @@ from roverlab.core.time import Duration, Time
 from roverlab.geometry import Transform3, quat_from_rpy, quat_from_yaw
 from roverlab.tf import (
     BackwardExtrapolationException,
+    Buffer,
     BufferCore,
     ConnectivityException,
     ExtrapolationException,
@@ -459,3 +461,56 @@ def test_a_lookup_repeated_at_a_stamp_sees_data_that_arrived_in_between() -> Non
     buf.clear()
     with pytest.raises(TransformException):
         buf.lookup_transform("odom", "base_link", s(2.0))
+
+
+class _Walking(BufferCore):
+    """The plain version: every lookup walks the tree (nothing remembered)."""
+
+    def _lookup_pose(self, target: str, source: str, t_ns: int) -> tuple[Any, int]:
+        return self._lookup_pose_at(target, source, t_ns)
+
+
+def test_a_latest_lookup_is_remembered_only_until_the_data_changes() -> None:
+    """``Time(0)`` lookups are remembered per (target, source) like stamped ones: always
+    the answer of a buffer that walks the tree every time; new data and ``clear`` are seen."""
+    buf, plain = Buffer(), _Walking()
+
+    def both(parent: str, child: str, t: float, x: float, *, is_static: bool = False) -> None:
+        for b in (buf, plain):
+            b.set_transform(parent, child, s(t), tf(x=x, yaw=x), is_static=is_static)
+
+    def check() -> None:
+        want = plain.lookup_transform("map", "laser", Time())
+        assert buf.lookup_transform("map", "laser", Time()) == want
+        assert buf.lookup_transform("map", "laser", Time()) == want  # remembered
+        assert buf.lookup_transform("odom", "laser", s(1.0)) == plain.lookup_transform(
+            "odom", "laser", s(1.0)
+        )
+
+    both("base_link", "laser", 0.0, 0.3, is_static=True)
+    both("map", "odom", 1.0, 0.0)
+    both("odom", "base_link", 1.0, 1.0)
+    check()
+    both("odom", "base_link", 2.0, 2.0)  # newer data: the latest common time is still 1 s
+    check()
+    both("map", "odom", 2.0, 0.5)  # now 2 s
+    check()
+    assert buf.lookup_transform("map", "laser", Time())[1] == s(2.0)
+    buf.clear()
+    with pytest.raises(TransformException):
+        buf.lookup_transform("map", "laser", Time())
+
+
+def test_buffer_lookup_without_timeout_matches_the_waiting_path() -> None:
+    """The no-timeout lookup (no closure) gives what the waiting path gives, errors too."""
+    buf = Buffer()
+    buf.set_transform("odom", "base_link", s(1.0), tf(x=1.0, yaw=0.2))
+    buf.set_transform("odom", "base_link", s(2.0), tf(x=2.0, yaw=0.4))
+    for t in (s(1.5), s(2.0), Time()):
+        fast = buf.lookup_transform("odom", "base_link", t)
+        slow = buf.lookup_transform("odom", "base_link", t, Duration(0))
+        assert fast == slow
+    for timeout in (0.0, Duration(0)):
+        with pytest.raises(ExtrapolationException) as err:
+            buf.lookup_transform("odom", "base_link", s(3.0), timeout)
+        assert "extrapolation into the future" in str(err.value).lower()

@@ -22,11 +22,15 @@ from typing import Any
 from roverlab.actionlib.status import GoalIDGenerator, GoalStatus, status_name
 from roverlab.core import Node, QoSProfile, Time
 from roverlab.msgs import ActionType, get_action_type, get_factory
+from roverlab.msgs._store import STORE, FieldKind
 
 __all__ = ["ActionServer", "ServerGoalHandle"]
 
 GoalID = get_factory("actionlib_msgs/msg/GoalID")
 GoalStatusMsg = get_factory("actionlib_msgs/msg/GoalStatus")
+_Header = get_factory("std_msgs/msg/Header")
+_GoalIDCls = GoalID.cls
+_GoalStatusCls = GoalStatusMsg.cls
 GoalStatusArray = get_factory("actionlib_msgs/msg/GoalStatusArray")
 
 _LATCHED = QoSProfile(depth=1, durability="transient_local")
@@ -299,10 +303,13 @@ class ActionServer:
 
     def _publish_feedback(self, status: Any, feedback: Any) -> None:
         with self.lock:
-            msg = self.spec.ActionFeedback()
-            msg.header.stamp = self._now().to_msg()
-            msg.status = _copy_status(status)
-            msg.feedback = _as_message(feedback, self.spec.Feedback)
+            # the rosbags class directly (a move_base cycle sends one): the fields the
+            # factory's defaults and three assignments would give, without the defaults
+            msg = self.spec.ActionFeedback.cls(
+                header=_Header.cls(stamp=self._now().to_msg(), frame_id=""),
+                status=_copy_status(status),
+                feedback=_as_message(feedback, self.spec.Feedback),
+            )
             if self.started:
                 self._feedback_pub.publish(msg)
 
@@ -371,9 +378,15 @@ class ActionServer:
 
 
 def _copy_status(status: Any) -> Any:
-    """A snapshot of a tracker's status (messages are passed by reference in process)."""
-    return GoalStatusMsg(
-        goal_id=GoalID(stamp=status.goal_id.stamp, id=status.goal_id.id),
+    """A snapshot of a tracker's status (messages are passed by reference in process).
+
+    Built with the rosbags classes directly: the tracker's fields were checked when it
+    was made, so the factory's checks would only repeat them (this runs for every
+    feedback and every status entry of every status message).
+    """
+    gid = status.goal_id
+    return _GoalStatusCls(
+        goal_id=_GoalIDCls(stamp=gid.stamp, id=str(gid.id)),
         status=int(status.status),
         text=str(status.text),
     )
@@ -383,5 +396,28 @@ def _as_message(value: Any, factory: Any) -> Any:
     if isinstance(value, factory.cls):
         return value
     if isinstance(value, dict):
+        fields = _message_fields(factory.typename)
+        if (
+            fields is not None
+            and value.keys() == fields.keys()
+            and all(getattr(type(v), "__msgtype__", None) == fields[k] for k, v in value.items())
+        ):
+            # every field given as a message of its type (move_base's feedback, each
+            # cycle): what from_dict makes of it, the values kept as they are, unchecked
+            return factory.cls(**value)
         return factory.from_dict(value)
     raise TypeError(f"expected {factory.typename}, got {type(value).__name__}")
+
+
+_MESSAGE_FIELDS: dict[str, dict[str, str] | None] = {}
+
+
+def _message_fields(typename: str) -> dict[str, str] | None:
+    """``{field: message type}`` of a type whose fields are all messages (else None)."""
+    if typename not in _MESSAGE_FIELDS:
+        spec = STORE.spec(typename)
+        kinds = {f.kind for f in spec.fields}
+        _MESSAGE_FIELDS[typename] = (
+            {f.name: f.typename for f in spec.fields} if kinds == {FieldKind.MESSAGE} else None
+        )
+    return _MESSAGE_FIELDS[typename]

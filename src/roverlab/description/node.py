@@ -33,7 +33,7 @@ from roverlab.description.errors import DescriptionError
 from roverlab.description.model import Joint, JointType, RobotModel
 from roverlab.description.urdf import load_robot
 from roverlab.geometry import Transform3
-from roverlab.msgs import Header, JointState, String
+from roverlab.msgs import JointState, String
 from roverlab.msgs import builders as build
 from roverlab.msgs import classes as mc
 from roverlab.tf import StaticTransformBroadcaster, TransformBroadcaster, transform_to_msg
@@ -330,13 +330,24 @@ class JointStatePublisher(Node):
 
     def publish(self) -> None:
         """Publish one JointState now (the timer calls this every 1/rate s)."""
+        self._pub.publish(self.message())
+
+    def message(self) -> mc.JointState:
+        """The JointState :meth:`publish` sends now (stamped with the node's clock)."""
         positions = self.positions()
         names = [j.name for j in self.joints]
-        msg = JointState(
-            header=Header(stamp=self.get_clock().now().to_msg()),
-            name=names,
-            position=[positions[n] for n in names],
-            velocity=[self._velocities.get(n, 0.0) for n in names] if self._velocities else [],
-            effort=[self._efforts.get(n, 0.0) for n in names] if self._efforts else [],
+        sec, nsec = divmod(self.get_clock().now_ns(), 1_000_000_000)
+        f64 = np.float64
+        # the builder, not the factory: the same fields and dtypes without re-checking
+        # numbers this node computed (the factory's lists become float64 arrays too)
+        return build.joint_state(
+            sec,
+            nsec,
+            "",
+            names,
+            np.array([positions[n] for n in names], dtype=f64),
+            np.array(
+                [self._velocities.get(n, 0.0) for n in names] if self._velocities else [], f64
+            ),
+            np.array([self._efforts.get(n, 0.0) for n in names] if self._efforts else [], f64),
         )
-        self._pub.publish(msg)

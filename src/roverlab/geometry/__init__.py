@@ -51,7 +51,10 @@ def quat_from_yaw(yaw: float) -> FloatArray:
 
 def yaw_from_quat(q: ArrayLike) -> float:
     """Yaw (rotation about z, radians) of quaternion (x, y, z, w), as tf's getYaw."""
-    x, y, z, w = (float(v) for v in np.asarray(q, dtype=np.float64))
+    if type(q) is tuple and len(q) == 4:  # a Transform3's rotation: no array needed
+        x, y, z, w = (float(v) for v in q)
+    else:
+        x, y, z, w = (float(v) for v in np.asarray(q, dtype=np.float64))
     return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
 
 

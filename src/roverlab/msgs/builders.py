@@ -20,9 +20,11 @@ from typing import Any
 from . import classes as mc
 
 __all__ = [
+    "DeferredLaserScan",
     "imu",
     "joint_state",
     "laser_scan",
+    "laser_scan_later",
     "odometry",
     "pose_stamped",
     "tf_message",
@@ -293,6 +295,72 @@ def laser_scan(
     m.range_min = range_min
     m.range_max = range_max
     m.ranges = ranges
+    m.intensities = intensities
+    m.__msgtype__ = _LASER_SCAN
+    return m
+
+
+class DeferredLaserScan(_LaserScan):  # type: ignore[misc,valid-type]
+    """A ``sensor_msgs/LaserScan`` whose ``ranges`` are made when first read (then kept):
+    the simulated lidar publishes 50 scans a second and the costmaps read the few their
+    updates use. Everything else is a LaserScan's: fields, ``__msgtype__``, serialisation;
+    a copy or pickle is a plain LaserScan. Equality, as for any dataclass, needs the same
+    class: compare fields (``ranges`` included), not the message.
+    """
+
+    @property
+    def ranges(self) -> Any:
+        d = self.__dict__
+        make = d.get("_make")
+        if make is None:
+            return d["_ranges"]
+        value = make()  # two threads may both make it: the same values, one kept
+        d["_ranges"] = value
+        d.pop("_make", None)
+        return value
+
+    @ranges.setter
+    def ranges(self, value: Any) -> None:
+        d = self.__dict__
+        d["_ranges"] = value
+        d.pop("_make", None)
+
+    def __reduce__(self) -> tuple[Any, tuple[Any, ...]]:
+        fields = (
+            self.header, self.angle_min, self.angle_max, self.angle_increment,
+            self.time_increment, self.scan_time, self.range_min, self.range_max, self.ranges,
+            self.intensities,
+        )  # fmt: skip
+        return _LaserScan, fields
+
+
+def laser_scan_later(
+    sec: int,
+    nanosec: int,
+    frame_id: str,
+    angle_min: float,
+    angle_max: float,
+    angle_increment: float,
+    time_increment: float,
+    scan_time: float,
+    range_min: float,
+    range_max: float,
+    ranges: Callable[[], Any],
+    intensities: Any,
+) -> Any:
+    """:func:`laser_scan` with ``ranges`` a function called when the field is first read
+    (a :class:`DeferredLaserScan`)."""
+    h = _header(sec, nanosec, frame_id)
+    m = _new(DeferredLaserScan)
+    m.header = h
+    m.angle_min = angle_min
+    m.angle_max = angle_max
+    m.angle_increment = angle_increment
+    m.time_increment = time_increment
+    m.scan_time = scan_time
+    m.range_min = range_min
+    m.range_max = range_max
+    m.__dict__["_make"] = ranges
     m.intensities = intensities
     m.__msgtype__ = _LASER_SCAN
     return m

@@ -31,7 +31,7 @@ from scipy import ndimage
 from roverlab.actionlib import GoalStatus, SimpleActionClient
 from roverlab.actionlib.status import STATUS_NAMES
 from roverlab.batch import episode_stop
-from roverlab.core import Context
+from roverlab.core import ClockMode, Context, Time
 from roverlab.description import find_package
 from roverlab.fileio import atomic_write_bytes
 from roverlab.geometry import wrap_angle
@@ -344,6 +344,10 @@ class _Episode:
         self.recoveries = 0
         self._mb_state = ""
         self._contacts = 0
+        # the episode's spin ends when _sample decides (executor.stop() after that event,
+        # where a stop_when() checked before every event would stop too: the executor's
+        # plain loop runs meanwhile, with no Python call between two events)
+        self._halt: Callable[[], None] | None = None
         node.create_timer(_SAMPLE_PERIOD_S, self._sample)
         fp = self.move_base.global_costmap.footprint
         self.inscribed = footprint_radii(fp)[0]
@@ -352,7 +356,7 @@ class _Episode:
         return self.ctx.now().nanoseconds / 1e9
 
     def _sample(self) -> None:
-        s, cfg = self.simulator, self.cfg
+        s = self.simulator
         t = self._now()
         self.trace.append((t, s.x, s.y, s.yaw))
         state = self.move_base.state
@@ -361,6 +365,14 @@ class _Episode:
         self._mb_state = state
         if self.outcome is not None or self._t_sent is None:
             return
+        self._judge(t, self._t_sent)
+        if self._halt is not None and (self.outcome is not None or episode_stop().is_set()):
+            self._halt()
+
+    def _judge(self, t: float, t_sent: float) -> None:
+        """Set the outcome once the episode is decided (``_sample`` at time ``t``, the
+        goal sent at ``t_sent``)."""
+        s, cfg = self.simulator, self.cfg
         if self.t_start is None and math.hypot(s.x - cfg.start[0], s.y - cfg.start[1]) >= (
             cfg.start_move_m
         ):
@@ -374,10 +386,34 @@ class _Episode:
                 return
         if math.hypot(s.x - cfg.goal[0], s.y - cfg.goal[1]) <= cfg.goal_tolerance_m:
             self.outcome = "succeeded"
-        elif t - (self.t_start if self.t_start is not None else self._t_sent) >= (cfg.time_limit_s):
+        elif t - (self.t_start if self.t_start is not None else t_sent) >= (cfg.time_limit_s):
             self.outcome = "timeout"
         elif self.client.get_state() not in (GoalStatus.PENDING, GoalStatus.ACTIVE):
             self.outcome = "timeout"  # given up (or "reached" short of the tolerance)
+
+    def _spin_until_decided(self, timeout_s: float) -> None:
+        """Spin until ``_sample`` has an outcome (or Ctrl-C), at most ``timeout_s`` of sim
+        time: what ``ctx.wait_for(lambda: outcome is not None or stop.is_set(), timeout_s)``
+        does, ending after the same event, without a condition called before every event."""
+        ex = self.ctx.executor
+        if ex.mode is not ClockMode.SIM or ex.stopped:
+            stop = episode_stop()
+            self.ctx.wait_for(lambda: self.outcome is not None or stop.is_set(), timeout_s)
+            return
+        halted = False
+
+        def halt() -> None:
+            nonlocal halted
+            halted = True
+            ex.stop()
+
+        self._halt = halt
+        try:
+            self.ctx.spin_until(Time(ex.now_ns + round(timeout_s * 1e9)))
+        finally:
+            self._halt = None
+            if halted:
+                ex.reset_stop()
 
     def run(self) -> FixedResult:
         cfg, s = self.cfg, self.simulator
@@ -395,9 +431,7 @@ class _Episode:
         self._contacts = c0 = s.contacts
         self.client.send_goal(_goal_msg(self.frame, goal))
         stop = episode_stop()  # Ctrl-C in a serial batch: end here, reported as interrupted
-        self.ctx.wait_for(
-            lambda: self.outcome is not None or stop.is_set(), cfg.time_limit_s * 3 + 60.0
-        )
+        self._spin_until_decided(cfg.time_limit_s * 3 + 60.0)
         outcome = self.outcome or ("interrupted" if stop.is_set() else "timeout")
         t_end = self._now()
         state = self.client.get_state()

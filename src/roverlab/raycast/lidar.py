@@ -15,6 +15,7 @@ measured from the x axis counter-clockwise; poses are ``(x, y, yaw)``.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numba
 import numpy as np
@@ -335,6 +336,32 @@ class Fan:
         pose[0], pose[1], pose[2] = x, y, yaw
         _run_scene(scene, self._pose, z, self.angles, self.range_max, self._unit, self._out)
         return self._out[0]
+
+    def cast_later(
+        self, scene: Scene, x: float, y: float, z: float, yaw: float
+    ) -> Callable[[], NDArray[np.float64]]:
+        """:meth:`cast` deferred: the pose is checked and the scene's arrays and grid are
+        taken now; the returned function casts (into arrays of its own, so it may run in
+        any thread, any number of times) and returns what :meth:`cast` returns now.
+
+        Raises:
+            RaycastInputError: a non-finite pose (now, as :meth:`cast`).
+        """
+        if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z) and math.isfinite(yaw)):
+            raise RaycastInputError(f"lidar pose must be finite, got ({x}, {y}, {z}, {yaw})")
+        g: Grid = scene_grid(scene)
+        arrays = (scene.segments, scene.segment_z, scene.circles, scene.circle_z)
+        angles, (ca, sa), rmax = self.angles, self._unit, self.range_max
+
+        def cast() -> NDArray[np.float64]:
+            out = np.empty((1, angles.shape[0]), dtype=np.float64)
+            _cast_2d_kernel(
+                np.array([[x, y, yaw]]), z, angles, ca, sa, rmax, *arrays,
+                g.x0, g.y0, g.cell, g.nx, g.ny, g.cell_start, g.items, g.n_segments, out,
+            )  # fmt: skip
+            return out[0]
+
+        return cast
 
 
 def cast_2d(

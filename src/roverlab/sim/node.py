@@ -420,10 +420,13 @@ class SimulatorNode(Node):
 
         def tick() -> None:
             x, y, z, yaw, _ = self.sensor_pose(sensor.mount)
-            ranges = model.scan(self.scene, x, y, z, yaw)
+            # the ranges are cast when a reader first asks for them (a costmap casts the
+            # scans its updates use; most of the 50 a second are replaced unread): the
+            # same values, the noise drawn now in the same order
+            ranges = model.scan_later(self.scene, x, y, z, yaw)
             sec, nsec = divmod(self._executor.now_ns, 1_000_000_000)
             pub.publish(
-                build.laser_scan(
+                build.laser_scan_later(
                     sec, nsec, sensor.frame_id, p.min_angle, p.max_angle, p.angle_increment,
                     0.0, scan_time, p.range_min, p.range_max, ranges, empty,
                 )

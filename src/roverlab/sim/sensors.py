@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 import sys
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -97,6 +98,23 @@ class LidarModel:
         p = self.params
         ranges = self._fan.cast(scene, x, y, z, yaw)
         return _finish_scan(ranges, self._noise_row(), p.range_min, p.range_max, p.range_resolution)
+
+    def scan_later(
+        self, scene: Scene, x: float, y: float, z: float, yaw: float
+    ) -> Callable[[], NDArray[np.float32]]:
+        """:meth:`scan` with the ray cast deferred: the noise row is drawn now (the same rows
+        in the same order as :meth:`scan` draws them), the pose checked now; the returned
+        function gives the ranges :meth:`scan` would have given now, whenever it is called.
+        """
+        p = self.params
+        cast = self._fan.cast_later(scene, x, y, z, yaw)
+        noise = self._noise_row()  # a row of a block that is replaced, never overwritten
+        rmin, rmax, res = p.range_min, p.range_max, p.range_resolution
+
+        def ranges() -> NDArray[np.float32]:
+            return _finish_scan(cast(), noise, rmin, rmax, res)
+
+        return ranges
 
 
 @numba.njit(cache=True, nogil=True)

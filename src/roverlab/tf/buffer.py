@@ -48,6 +48,7 @@ class Buffer(BufferCore):
     def __init__(self, *, cache_time: Duration | float = DEFAULT_CACHE_TIME) -> None:
         super().__init__(cache_time=cache_time)
         self._cond = threading.Condition(threading.RLock())
+        self._waiters = 0  # lookups waiting in _wait: set_transform wakes them only then
         self._requests: list[tuple[str, str, Time, Future[tuple[Transform3, Time]]]] = []
 
     # ------------------------------------------------------------------ input
@@ -67,7 +68,8 @@ class Buffer(BufferCore):
             )
             if not stored:
                 return False
-            self._cond.notify_all()
+            if self._waiters:
+                self._cond.notify_all()
             done = self._test_requests() if self._requests else []
         for fut, result, error in done:
             try:
@@ -100,6 +102,11 @@ class Buffer(BufferCore):
     ) -> tuple[Transform3, Time]:
         """:meth:`BufferCore.lookup_transform`, first waiting up to ``timeout`` for the
         transform to become available; then the lookup's own error is raised, as tf2_ros."""
+        if type(timeout) is not Duration and timeout == 0.0:
+            # no wait (every lookup of the executor's callbacks): the lookup under the
+            # lock, as _lookup_waiting does it, without building its closure
+            with self._cond:
+                return BufferCore.lookup_transform(self, target_frame, source_frame, time)
         return self._lookup_waiting(
             functools.partial(super().lookup_transform, target_frame, source_frame, time),
             timeout,
@@ -269,13 +276,17 @@ class Buffer(BufferCore):
         if timeout_s <= 0.0:
             return False
         deadline = _walltime.monotonic() + timeout_s
-        while True:
-            remaining = deadline - _walltime.monotonic()
-            if remaining <= 0.0:
-                return ready()
-            self._cond.wait(remaining)
-            if ready():
-                return True
+        self._waiters += 1
+        try:
+            while True:
+                remaining = deadline - _walltime.monotonic()
+                if remaining <= 0.0:
+                    return ready()
+                self._cond.wait(remaining)
+                if ready():
+                    return True
+        finally:
+            self._waiters -= 1
 
     def _test_requests(
         self,

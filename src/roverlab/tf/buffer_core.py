@@ -94,6 +94,9 @@ class BufferCore:
         # (target, source, stamp) -> the pose found, until the data next changes: a
         # message is looked up several times at its stamp (message filters, costmaps)
         self._found: dict[tuple[str, str, int], Pose] = {}
+        # (target, source) -> (pose, latest common time) of a Time(0) lookup, the same way
+        # (a robot pose is asked for by both costmaps and move_base between two TF updates)
+        self._found_latest: dict[tuple[str, str], tuple[Pose, int]] = {}
         self._authority: dict[str, str] = {}
 
     @property
@@ -179,6 +182,7 @@ class BufferCore:
         n = math.sqrt(n2)
         sample: Sample = (parent, (tx, ty, tz, qx / n, qy / n, qz / n, qw / n))
         self._found.clear()
+        self._found_latest.clear()
         self._frames.setdefault(child, None)
         self._frames.setdefault(parent, None)
         cache = self._caches.get(child)
@@ -196,6 +200,7 @@ class BufferCore:
     def clear(self) -> None:
         """Drop all dynamic data (static transforms and known frame ids stay), as tf2."""
         self._found.clear()
+        self._found_latest.clear()
         for cache in self._caches.values():
             cache.clear()
 
@@ -431,7 +436,13 @@ class BufferCore:
                     self._found.clear()
                 self._found[key] = found
             return found, t_ns
-        return self._lookup_pose_at(target, source, t_ns)
+        hit = self._found_latest.get((target, source))
+        if hit is None:
+            hit = self._lookup_pose_at(target, source, 0)
+            if len(self._found_latest) >= _FOUND_MAX:
+                self._found_latest.clear()
+            self._found_latest[(target, source)] = hit
+        return hit
 
     def _lookup_pose_at(self, target: str, source: str, t_ns: int) -> tuple[Pose, int]:
         frames = self._frames

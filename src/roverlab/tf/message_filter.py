@@ -181,6 +181,8 @@ class TfMessageFilter:
             return
 
     def _ready(self, msg: Any, targets: list[str]) -> str:
+        if not targets:  # no optional frames (the usual case)
+            return "ready"
         frame = str(msg.header.frame_id).lstrip("/")
         stamp = Time.from_msg(msg.header.stamp)
         for target in targets:

@@ -217,3 +217,35 @@ def test_each_setup_is_warmed_up_once_per_process_with_a_short_episode(
     fixed._warm_up(replace(base, world="other", seed=3))  # same setup: no second warm-up
     fixed._warm_up(replace(base, planner="dwa"))
     assert [(c.planner, c.time_limit_s) for c in made] == [("teb", 3.0), ("dwa", 3.0)]
+
+
+def test_the_episode_stops_after_the_same_event_as_a_condition_checked_every_event(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The episode's spin ends by ``executor.stop()`` from the sampling timer; the plain
+    version (``ctx.wait_for`` with the outcome as condition, checked before every event)
+    ends after the same event: the same trace, clock and outcome."""
+    import roverlab.navbench.fixed as fixed
+    from roverlab.batch import episode_stop
+
+    cfg = replace(_room(tmp_path), time_limit_s=1.5)  # ends as a timeout, 1.5 s in
+
+    def episode() -> fixed.FixedResult:
+        ep = fixed._Episode(cfg, lambda _line: None)
+        try:
+            return ep.run()
+        finally:
+            ep.ctx.shutdown()
+            ep._tmp.cleanup()
+
+    fast = episode()
+
+    def plain(self: fixed._Episode, timeout_s: float) -> None:
+        stop = episode_stop()
+        self.ctx.wait_for(lambda: self.outcome is not None or stop.is_set(), timeout_s)
+
+    monkeypatch.setattr(fixed._Episode, "_spin_until_decided", plain)
+    slow = episode()
+    assert fast.status == slow.status == "timeout"
+    assert fast.sim_time_s == slow.sim_time_s and fast.time_s == slow.time_s
+    assert np.array_equal(fast.trace, slow.trace) and len(fast.trace) > 20
