@@ -410,11 +410,11 @@ def inflate(
             if not seen[idx]:
                 seen[idx] = True
                 taken += 1
-                mx = idx % w
                 my = idx // w
+                mx = idx - my * w
                 src = node_src[k]
-                sx = src % w
                 sy = src // w
+                sx = src - sy * w
                 cost = cost_of[abs(mx - sx), abs(my - sy)]
                 old = flat[idx]
                 if old == NO_INFO and (
@@ -423,26 +423,32 @@ def inflate(
                     flat[idx] = cost
                 else:
                     flat[idx] = max(old, cost)
-                for nb in range(4):
+                for nb in range(4):  # the neighbour's cell from this one's: no division
+                    nx = mx
+                    ny = my
                     if nb == 0:
                         if mx == 0:
                             continue
                         nidx = idx - 1
+                        nx = mx - 1
                     elif nb == 1:
                         if my == 0:
                             continue
                         nidx = idx - w
+                        ny = my - 1
                     elif nb == 2:
                         if mx == w - 1:
                             continue
                         nidx = idx + 1
+                        nx = mx + 1
                     else:
                         if my == h - 1:
                             continue
                         nidx = idx + w
+                        ny = my + 1
                     if seen[nidx]:
                         continue
-                    nb_bin = bin_of[abs(nidx % w - sx), abs(nidx // w - sy)]
+                    nb_bin = bin_of[abs(nx - sx), abs(ny - sy)]
                     if nb_bin < 0 or nn >= cap:
                         continue
                     node_cell[nn] = nidx

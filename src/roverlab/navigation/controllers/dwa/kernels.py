@@ -79,8 +79,11 @@ def target_distance_window(
     h, w = costs.shape
     size = h * w
     pw = w + 2
+    # state & 3: 0 free and unseen, 1 an obstacle unseen, 2 seen (or the border), 3 reached
+    # and to be expanded; + 4: inside the window grown by one cell (its expansion is
+    # counted down in ``pending``; no division per cell to find it out)
     state = np.full((h + 2) * pw, 2, dtype=np.uint8)
-    dist = np.full((h + 2) * pw, size + 1, dtype=np.int64)
+    dist = np.full((h + 2) * pw, size + 1, dtype=np.int32)
     # the window grown by one cell, clipped to the grid (bordered coordinates)
     gx0 = max(window[0] - 1, 0) + 1
     gy0 = max(window[1] - 1, 0) + 1
@@ -91,34 +94,34 @@ def target_distance_window(
         row = (y + 1) * pw + 1
         inside_y = gy0 <= y + 1 <= gy1
         for x in range(w):
+            inside = inside_y and gx0 <= x + 1 <= gx1
             if costs[y, x] >= INSCRIBED:  # inscribed, lethal, unknown
-                state[row + x] = 1
+                state[row + x] = 5 if inside else 1
+            elif inside:
+                state[row + x] = 4
+                pending += 1
             else:
                 state[row + x] = 0
-                if inside_y and gx0 <= x + 1 <= gx1:
-                    pending += 1
     queue = np.empty(size + seeds.shape[0], dtype=np.int64)
     qh = 0
     qt = 0
     for k in range(seeds.shape[0]):
-        sx = seeds[k, 0] + 1
-        sy = seeds[k, 1] + 1
-        idx = sy * pw + sx
-        if state[idx] == 1 and gy0 <= sy <= gy1 and gx0 <= sx <= gx1:
+        idx = (seeds[k, 1] + 1) * pw + seeds[k, 0] + 1
+        st = state[idx]
+        if st == 5:
             pending += 1  # a seed on an obstacle is expanded too (a free one is counted)
-        state[idx] = 3  # reached, to be expanded
+        if st & 3 != 3:
+            state[idx] = 3 | (st & 4)  # reached, to be expanded
         dist[idx] = 0
         queue[qt] = idx
         qt += 1
     while qh < qt and pending > 0:
         cur = queue[qh]
         qh += 1
-        if state[cur] == 3:
+        st = state[cur]
+        if st & 3 == 3:
             state[cur] = 2
-            cy = cur // pw
-            cx = cur - cy * pw
-            if gy0 <= cy <= gy1 and gx0 <= cx <= gx1:
-                pending -= 1
+            pending -= st >> 2
         d = dist[cur] + 1
         for nb in range(4):
             if nb == 0:
@@ -129,14 +132,14 @@ def target_distance_window(
                 n = cur - pw
             else:
                 n = cur + pw
-            st = state[n]
+            st = state[n] & 3
             if st >= 2:
                 continue
             if st == 1:
                 state[n] = 2
                 dist[n] = size
                 continue
-            state[n] = 3  # reached, to be expanded
+            state[n] = state[n] | 3  # reached, to be expanded
             dist[n] = d
             queue[qt] = n
             qt += 1
@@ -213,19 +216,9 @@ def rollout(
     pose's ``cos(th)`` and ``sin(th)`` too). Returns ``(num_steps, extra_steps, dt)``;
     ``num_steps`` 0 if the sample gives no trajectory.
     """
-    vmag = math.hypot(target[0], target[1])
-    num = int(
-        math.ceil(
-            max(
-                vmag * sim_time / sim_granularity,
-                abs(target[2]) * sim_time / angular_sim_granularity,
-            )
-        )
-    )
+    num, extra, dt = _steps(target, sim_time, sim_granularity, angular_sim_granularity, extra_time)
     if num == 0:
         return 0, 0, 0.0
-    dt = sim_time / num
-    extra = int(math.ceil(extra_time / dt - 1e-9)) if extra_time > 0 else 0
     cap = out.shape[0]
     if num + extra > cap:
         extra = max(0, cap - num)
@@ -261,6 +254,152 @@ def rollout(
 
 
 @_jit
+def _steps(
+    target: NDArray[np.float64],
+    sim_time: float,
+    sim_granularity: float,
+    angular_sim_granularity: float,
+    extra_time: float,
+) -> tuple[int, int, float]:
+    """A rollout's ``(num_steps, extra_steps, dt)`` (``num_steps`` 0: no trajectory)."""
+    vmag = math.hypot(target[0], target[1])
+    num = int(
+        math.ceil(
+            max(
+                vmag * sim_time / sim_granularity,
+                abs(target[2]) * sim_time / angular_sim_granularity,
+            )
+        )
+    )
+    if num == 0:
+        return 0, 0, 0.0
+    dt = sim_time / num
+    extra = int(math.ceil(extra_time / dt - 1e-9)) if extra_time > 0 else 0
+    return num, extra, dt
+
+
+@_jit
+def _accelerate1(target: float, cur: float, acc: float, dt: float) -> float:
+    """One component of :func:`_accelerate`."""
+    if cur < target:
+        return min(target, cur + acc * dt)
+    return max(target, cur - acc * dt)
+
+
+@_jit
+def _headings(
+    th0: float,
+    vth0: float,
+    target_vth: float,
+    num: int,
+    steps: int,
+    dt: float,
+    continued_acceleration: bool,
+    acc_th: float,
+    out: NDArray[np.float64],
+) -> None:
+    """``th``, ``cos th``, ``sin th`` of the first ``steps`` poses of :func:`rollout` for a
+    sample of angular velocity ``target_vth`` in ``num`` steps of ``dt`` (the headings do
+    not depend on the linear velocity: the same floating-point operations as there)."""
+    th = th0
+    vth = target_vth
+    if continued_acceleration:
+        vth = _accelerate1(target_vth, vth0, acc_th, dt)
+    for i in range(steps):
+        out[i, 0] = th
+        out[i, 1] = math.cos(th)
+        out[i, 2] = math.sin(th)
+        if continued_acceleration and i < num:
+            vth = _accelerate1(target_vth, vth, acc_th, dt)
+        th += vth * dt
+
+
+@_jit
+def _roll_headed(
+    pos: NDArray[np.float64],
+    vel: NDArray[np.float64],
+    target_vx: float,
+    num: int,
+    steps: int,
+    dt: float,
+    continued_acceleration: bool,
+    acc_x: float,
+    heads: NDArray[np.float64],
+    out: NDArray[np.float64],
+) -> None:
+    """The first ``steps`` poses of :func:`rollout` (five columns) of a sample with no
+    lateral velocity (``vy`` 0 throughout), from its headings (:func:`_headings`): the
+    same values, bit for bit, with no sine or cosine computed."""
+    x = pos[0]
+    y = pos[1]
+    vx = target_vx
+    if continued_acceleration:
+        vx = _accelerate1(target_vx, vel[0], acc_x, dt)
+    for i in range(steps):
+        c = heads[i, 1]
+        s = heads[i, 2]
+        out[i, 0] = x
+        out[i, 1] = y
+        out[i, 2] = heads[i, 0]
+        out[i, 3] = c
+        out[i, 4] = s
+        if continued_acceleration and i < num:
+            vx = _accelerate1(target_vx, vx, acc_x, dt)
+        x += vx * c * dt
+        y += vx * s * dt
+
+
+@_jit
+def _shared_rollout(
+    k: int,
+    samples: NDArray[np.float64],
+    pos: NDArray[np.float64],
+    vel: NDArray[np.float64],
+    gen: NDArray[np.float64],
+    acc: NDArray[np.float64],
+    continued_acceleration: bool,
+    extra_time: float,
+    keys: NDArray[np.float64],
+    nkeys: NDArray[np.int64],
+    heads: NDArray[np.float64],
+    traj: NDArray[np.float64],
+) -> tuple[int, int]:
+    """:func:`rollout` of sample ``k`` into ``traj`` (``(num, extra)``), its headings
+    computed once per ``(vth, num)`` for every sample of :func:`score_rollouts` that has
+    them (``keys``: vth, num and the heading row of each computed so far, ``nkeys[0]`` of
+    them; ``heads``: one ``(cap, 3)`` block each, with the steps of ``gen[6]`` more
+    seconds). A sample with a lateral velocity is rolled out plainly."""
+    target = samples[k]
+    if target[1] != 0.0 or (continued_acceleration and vel[1] != 0.0):
+        num, extra, _dt = rollout(
+            pos, vel, target, gen[0], gen[1], gen[2], continued_acceleration, acc, extra_time,
+            traj,
+        )  # fmt: skip
+        return num, extra
+    num, extra, dt = _steps(target, gen[0], gen[1], gen[2], extra_time)
+    if num == 0:
+        return 0, 0
+    row = -1
+    for j in range(nkeys[0]):
+        if keys[j, 0] == target[2] and keys[j, 1] == num:
+            row = j
+            break
+    if row < 0:
+        row = nkeys[0]
+        nkeys[0] += 1
+        full, _e, _d = _steps(target, gen[0], gen[1], gen[2], gen[6])
+        keys[row, 0] = target[2]
+        keys[row, 1] = num
+        _headings(
+            pos[2], vel[2], target[2], num, full + _e, dt, continued_acceleration, acc[2],
+            heads[row],
+        )  # fmt: skip
+    _roll_headed(pos, vel, target[0], num, num + extra, dt, continued_acceleration, acc[0],
+                 heads[row], traj)  # fmt: skip
+    return num, extra
+
+
+@_jit
 def _accelerate(
     target: NDArray[np.float64],
     vx: float,
@@ -269,14 +408,11 @@ def _accelerate(
     acc: NDArray[np.float64],
     dt: float,
 ) -> tuple[float, float, float]:
-    out = np.empty(3)
-    cur = (vx, vy, vth)
-    for i in range(3):
-        if cur[i] < target[i]:
-            out[i] = min(target[i], cur[i] + acc[i] * dt)
-        else:
-            out[i] = max(target[i], cur[i] - acc[i] * dt)
-    return out[0], out[1], out[2]
+    return (
+        _accelerate1(target[0], vx, acc[0], dt),
+        _accelerate1(target[1], vy, acc[1], dt),
+        _accelerate1(target[2], vth, acc[2], dt),
+    )
 
 
 @_jit
@@ -480,7 +616,13 @@ def score_rollouts(
     twirl_s = scales[5]
     occ_s = scales[0]
     nk = samples.shape[0]
-    traj = np.empty((8, 5))
+    cap = 8
+    for k in range(nk):
+        cap = max(cap, _rollout_cap(samples[k, 0], samples[k, 1], samples[k, 2], gen))
+    traj = np.empty((cap, 5))
+    keys = np.empty((nk, 2))
+    nkeys = np.zeros(1, dtype=np.int64)
+    heads = np.empty((nk, cap, 3))
     buf = np.empty((w + h + 4, 2), dtype=np.int64)
     partial = np.empty(nk)
     for k in range(nk):
@@ -490,11 +632,8 @@ def score_rollouts(
         if not _gen_ok(vx, vy, vth, gen):
             out[k] = -100.0
             continue
-        need = _rollout_cap(vx, vy, vth, gen)
-        if traj.shape[0] < need:
-            traj = np.empty((need, 5))
-        num, _extra, _dt = rollout(
-            pos, vel, samples[k], gen[0], gen[1], gen[2], continued_acceleration, acc, 0.0, traj
+        num, _extra = _shared_rollout(
+            k, samples, pos, vel, gen, acc, continued_acceleration, 0.0, keys, nkeys, heads, traj
         )
         if num == 0:
             out[k] = -100.0
@@ -540,11 +679,8 @@ def score_rollouts(
             continue
         vx = samples[k, 0]
         vy = samples[k, 1]
-        need = _rollout_cap(vx, vy, samples[k, 2], gen)
-        if traj.shape[0] < need:
-            traj = np.empty((need, 5))
-        num, extra, _dt = rollout(
-            pos, vel, samples[k], gen[0], gen[1], gen[2], continued_acceleration, acc, gen[6],
+        num, extra = _shared_rollout(
+            k, samples, pos, vel, gen, acc, continued_acceleration, gen[6], keys, nkeys, heads,
             traj,
         )  # fmt: skip
         vmag = math.hypot(vx, vy)
