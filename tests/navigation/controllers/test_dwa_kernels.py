@@ -18,6 +18,7 @@ from roverlab.navigation.controllers.dwa.kernels import (
     _shared_rollout,
     first_known_stretch,
     rollout,
+    sample_grid,
 )
 from roverlab.navigation.controllers.dwa.planner import _adjust_resolution
 from roverlab.navigation.costmap import Costmap2D
@@ -280,3 +281,14 @@ def test_rollouts_sharing_their_headings_are_the_plain_rollouts_bit_for_bit(
                 assert got[:m].tobytes() == want[:m].tobytes()
         if not (continued and vel[1] != 0.0):  # else every sample is rolled out plainly
             assert 0 < nkeys[0] < len(samples)  # headings were shared
+
+
+def test_the_sample_grid_is_every_combination_theta_fastest() -> None:
+    """The compiled sample grid against numpy's repeat / tile layout of the samples."""
+    rng = np.random.default_rng(2)
+    for nx, ny, nth in ((1, 1, 1), (6, 1, 20), (3, 4, 5)):
+        xs, ys, ths = rng.normal(size=nx), rng.normal(size=ny), rng.normal(size=nth)
+        want = np.column_stack(
+            [np.repeat(xs, ny * nth), np.tile(np.repeat(ys, nth), nx), np.tile(ths, nx * ny)]
+        )
+        assert sample_grid(xs, ys, ths).tobytes() == want.tobytes()

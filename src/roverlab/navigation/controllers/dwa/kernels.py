@@ -34,6 +34,7 @@ from roverlab.navigation.costmap.kernels import cells_cost, footprint_cells
 __all__ = [
     "first_known_stretch",
     "rollout",
+    "sample_grid",
     "score_rollouts",
     "target_distance",
     "target_distance_window",
@@ -251,6 +252,23 @@ def rollout(
             y += vx * s * dt
         th += vth * dt
     return num, extra, dt
+
+
+@_jit
+def sample_grid(
+    xs: NDArray[np.float64], ys: NDArray[np.float64], ths: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """Every ``(x, y, th)`` of the three velocity samplings, ``th`` fastest, then ``y``."""
+    out = np.empty((xs.shape[0] * ys.shape[0] * ths.shape[0], 3))
+    k = 0
+    for x in xs:
+        for y in ys:
+            for th in ths:
+                out[k, 0] = x
+                out[k, 1] = y
+                out[k, 2] = th
+                k += 1
+    return out
 
 
 @_jit

@@ -56,6 +56,7 @@ from roverlab.navigation.controllers.dwa.in_place import (
 )
 from roverlab.navigation.controllers.dwa.kernels import (
     first_known_stretch,
+    sample_grid,
     score_rollouts,
     target_distance_window,
 )
@@ -405,10 +406,7 @@ class DWAPlanner(EscapeMixin):
         xs = velocity_iterator(lo[0], hi[0], nx)
         ys = velocity_iterator(lo[1], hi[1], ny)
         ths = velocity_iterator(lo[2], hi[2], nth)
-        grid = np.empty((len(xs) * len(ys) * len(ths), 3))  # every (x, y, th), th fastest
-        grid[:, 0] = np.repeat(xs, len(ys) * len(ths))
-        grid[:, 1] = np.tile(np.repeat(ys, len(ths)), len(xs))
-        grid[:, 2] = np.tile(ths, len(xs) * len(ys))
+        grid = sample_grid(np.array(xs), np.array(ys), np.array(ths))
         if rotations:  # TrajectoryPlanner's, whatever min_vel_x is
             grid = np.concatenate([grid, in_place_samples(lo[2], hi[2], nth, p.min_vel_theta)])
         return np.ascontiguousarray(grid, dtype=np.float64)
