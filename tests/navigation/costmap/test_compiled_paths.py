@@ -1,12 +1,16 @@
-"""The inflation layer's compiled pass against a plain version of costmap_2d's ordered
-propagation (``InflationLayer::updateCosts``), bit for bit: a speed-up of the kernel
-changes no cost."""
+"""The costmaps' compiled passes against plain versions, bit for bit, so a speed-up
+changes no cost: the inflation layer's ordered propagation (``InflationLayer::updateCosts``),
+the footprint placed at a pose, and the footprint's cells filled on the grid."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-from roverlab.navigation.costmap.kernels import inflate
+from roverlab.navigation.costmap import Costmap2D
+from roverlab.navigation.costmap.footprint import transform_footprint
+from roverlab.navigation.costmap.kernels import convex_fill, inflate
 
 LETHAL, INSCRIBED, UNKNOWN = 254, 253, 255
 
@@ -71,3 +75,24 @@ def test_inflate_is_the_plain_ordered_propagation_bit_for_bit() -> None:
         )  # fmt: skip
         assert n_got == n_want
         assert got.tobytes() == want.tobytes()
+
+
+def test_the_footprint_placed_and_filled_is_numpys_and_world_to_maps() -> None:
+    rng = np.random.default_rng(12)
+    cm = Costmap2D(size_x=60, size_y=50, resolution=0.05, origin_x=-1.3, origin_y=0.7)
+    for _ in range(300):
+        fp = rng.uniform(-0.4, 0.4, (int(rng.integers(3, 9)), 2))
+        x, y, yaw = rng.uniform(-1.5, 2.0), rng.uniform(0.5, 3.5), rng.uniform(-4, 4)
+        c, s = math.cos(yaw), math.sin(yaw)
+        want = np.column_stack([x + fp[:, 0] * c - fp[:, 1] * s, y + fp[:, 0] * s + fp[:, 1] * c])
+        placed = transform_footprint(x, y, yaw, fp)
+        assert placed.tobytes() == want.tobytes()
+        hull = placed[np.argsort(np.arctan2(*(placed - placed.mean(axis=0)).T[::-1]))]
+        cells = [cm.world_to_map(float(px), float(py)) for px, py in hull]
+        ref = cm.costs.copy()
+        if all(cell is not None for cell in cells):
+            convex_fill(ref, np.array(cells, dtype=np.int64), 77)
+        before = cm.costs.copy()
+        assert cm.set_convex_polygon_cost(hull, 77) == all(cell is not None for cell in cells)
+        assert cm.costs.tobytes() == ref.tobytes()
+        cm.costs[:] = before
