@@ -68,9 +68,11 @@ def test_inflate_is_the_plain_ordered_propagation_bit_for_bit() -> None:
         n_want = _plain_inflate(want, (x0, y0, xn, yn), bins, cost_of, len(levels), unknown)
         got = grid.copy()
         cap = 5 * h * w + 16
+        # ``seen`` as an earlier call left it (only the cells near the window are cleared)
+        seen = rng.random(h * w) < 0.5
         n_got = inflate(
-            got, x0, y0, xn, yn, r, bins, cost_of, len(levels), unknown,
-            np.zeros(h * w, dtype=np.bool_), *(np.empty(cap, dtype=np.int64) for _ in range(3)),
+            got, x0, y0, xn, yn, r, bins, cost_of, len(levels), unknown, seen,
+            *(np.empty(cap, dtype=np.int64) for _ in range(3)),
             np.empty(len(levels), dtype=np.int64), np.empty(len(levels), dtype=np.int64),
         )  # fmt: skip
         assert n_got == n_want
