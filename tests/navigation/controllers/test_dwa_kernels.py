@@ -15,12 +15,11 @@ from roverlab.geometry import SE2
 from roverlab.navigation.controllers import DWAParams, DWAPlanner, Velocity2D
 from roverlab.navigation.controllers.dwa.kernels import (
     _rollout_cap,
-    _shared_rollout,
     first_known_stretch,
-    rollout,
     sample_grid,
 )
 from roverlab.navigation.controllers.dwa.planner import _adjust_resolution
+from roverlab.navigation.controllers.dwa.rollouts import rollout, shared_rollout
 from roverlab.navigation.costmap import Costmap2D
 from roverlab.navigation.costmap.kernels import bresenham, footprint_cost
 from roverlab.navigation.errors import NoValidControlError
@@ -271,7 +270,7 @@ def test_rollouts_sharing_their_headings_are_the_plain_rollouts_bit_for_bit(
             for k in rng.permutation(len(samples)):
                 got = np.full((cap, 5), np.nan)
                 want = np.full((cap, 5), np.nan)
-                n1 = _shared_rollout(
+                n1 = shared_rollout(
                     k, samples, pos, vel, gen, acc, continued, extra_time, keys, nkeys, heads,
                     got,
                 )  # fmt: skip
