@@ -8,8 +8,14 @@ from collections import deque
 
 import numpy as np
 
-from roverlab.navigation.controllers.dwa.kernels import target_distance, target_distance_window
-from roverlab.navigation.controllers.dwa.planner import _adjust_resolution
+from roverlab.geometry import SE2
+from roverlab.navigation.controllers.dwa.kernels import (
+    rollout,
+    target_distance,
+    target_distance_window,
+)
+from roverlab.navigation.controllers.dwa.planner import _adjust_resolution, _forward_window
+from roverlab.navigation.costmap import Costmap2D
 
 
 def _reference_wave(costs: np.ndarray, seeds: list[tuple[int, int]]) -> np.ndarray:
@@ -94,3 +100,35 @@ def test_adjust_resolution_inserts_even_points_up_to_the_resolution() -> None:
     for i, k in enumerate(steps):  # the inserted points split each segment evenly
         np.testing.assert_allclose(spacing[at[i] : at[i + 1]], gaps[i] / k, rtol=1e-9)
     assert _adjust_resolution(plan[:1], res).shape == (1, 2)
+
+
+def test_the_forward_window_holds_every_cell_a_forward_rollout_reads() -> None:
+    """With constant velocities, vx >= 0, no lateral motion and at most half a turn over
+    sim_time, the grid critics read (every pose's cell, the last goal-front point's)
+    only inside the cut window: the cut is a bound, not a guess."""
+    rng = np.random.default_rng(9)
+    cm = Costmap2D(size_x=200, size_y=200, resolution=0.05, origin_x=-5.0, origin_y=-5.0)
+    acc = np.array([2.5, 0.0, 3.2])
+    traj = np.empty((4000, 5))
+    cut = 0
+    for _ in range(300):
+        sim_time = float(rng.uniform(0.5, 3.0))
+        max_th = math.pi / sim_time * float(rng.uniform(0.3, 1.0))
+        v_max, fpd = float(rng.uniform(0.1, 1.0)), float(rng.uniform(0.0, 0.5))
+        pose = SE2(*rng.uniform(-2, 2, 2), float(rng.uniform(-math.pi, math.pi)))
+        reach = v_max * sim_time + fpd
+        r = math.ceil(reach / cm.resolution) + 2
+        cx, cy = math.floor((pose.x + 5.0) / 0.05), math.floor((pose.y + 5.0) / 0.05)
+        square = np.array([cx - r, cy - r, cx + r, cy + r], dtype=np.int64)
+        win = _forward_window(pose, cm, reach, fpd, square)
+        cut += int((win != square).any())
+        for vx, vth in rng.uniform((0.0, -max_th), (v_max, max_th), (20, 2)):
+            num, _, _ = rollout(
+                pose.as_array(), np.zeros(3), np.array([vx, 0.0, vth]), sim_time, 0.025,
+                0.1, False, acc, 0.0, traj,
+            )  # fmt: skip
+            pts = [traj[:num, :2], traj[num - 1 : num, :2] + fpd * traj[num - 1 : num, 3:5]]
+            for x, y in np.vstack(pts):
+                mx, my = int((x + 5.0) / 0.05), int((y + 5.0) / 0.05)
+                assert win[0] <= mx <= win[2] and win[1] <= my <= win[3]
+    assert cut > 200  # the window was cut in most cases

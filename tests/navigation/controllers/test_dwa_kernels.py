@@ -13,8 +13,13 @@ import pytest
 
 from roverlab.geometry import SE2
 from roverlab.navigation.controllers import DWAParams, DWAPlanner, Velocity2D
-from roverlab.navigation.controllers.dwa.kernels import first_known_stretch
+from roverlab.navigation.controllers.dwa.kernels import (
+    _rollout_cap,
+    first_known_stretch,
+    sample_grid,
+)
 from roverlab.navigation.controllers.dwa.planner import _adjust_resolution
+from roverlab.navigation.controllers.dwa.rollouts import rollout, shared_rollout
 from roverlab.navigation.costmap import Costmap2D
 from roverlab.navigation.costmap.kernels import bresenham, footprint_cost
 from roverlab.navigation.errors import NoValidControlError
@@ -239,3 +244,50 @@ def test_first_known_stretch_is_the_adjusted_plan_looked_up() -> None:
         np.testing.assert_array_equal(got, want)
         lengths.add(min(len(want), 2))
     assert lengths == {0, 1, 2}  # none known, a single cell and longer stretches all met
+
+
+@pytest.mark.parametrize("continued", [False, True])
+def test_rollouts_sharing_their_headings_are_the_plain_rollouts_bit_for_bit(
+    continued: bool,
+) -> None:
+    """score_rollouts computes a heading sequence once for every sample with the same
+    angular velocity and step count: each trajectory must still be rollout's, bit for bit
+    (with and without continued acceleration, lateral samples rolled out plainly)."""
+    rng = np.random.default_rng(8)
+    gen = np.array([1.7, 0.025, 0.1, 0.0, 0.55, 0.0, 0.2])
+    acc = np.array([2.5, 1.0, 3.2])
+    for trial in range(20):
+        vx = np.round(rng.uniform(-0.2, 0.55, 5), 3)
+        vth = np.round(rng.uniform(-1.0, 1.0, 7), 3)
+        vy = [0.0, 0.1] if trial % 4 == 3 else [0.0]
+        samples = np.array([(x, y, th) for x in vx for y in vy for th in vth] + [(0.0, 0.0, 0.0)])
+        pos = np.array([rng.uniform(-3, 3), rng.uniform(-3, 3), rng.uniform(-math.pi, math.pi)])
+        vel = np.array([rng.uniform(0, 0.5), 0.05 if trial % 5 == 4 else 0.0, rng.uniform(-1, 1)])
+        cap = 8 + max(_rollout_cap(s[0], s[1], s[2], gen) for s in samples)
+        keys, nkeys = np.empty((len(samples), 2)), np.zeros(1, dtype=np.int64)
+        heads = np.empty((len(samples), cap, 3))
+        for extra_time in (0.0, gen[6]):
+            for k in rng.permutation(len(samples)):
+                got = np.full((cap, 5), np.nan)
+                want = np.full((cap, 5), np.nan)
+                n1 = shared_rollout(
+                    k, samples, pos, vel, gen, acc, continued, extra_time, keys, nkeys, heads,
+                    got,
+                )  # fmt: skip
+                n2 = rollout(pos, vel, samples[k], *gen[:3], continued, acc, extra_time, want)
+                assert n1 == n2[:2]
+                m = n1[0] + n1[1]
+                assert got[:m].tobytes() == want[:m].tobytes()
+        if not (continued and vel[1] != 0.0):  # else every sample is rolled out plainly
+            assert 0 < nkeys[0] < len(samples)  # headings were shared
+
+
+def test_the_sample_grid_is_every_combination_theta_fastest() -> None:
+    """The compiled sample grid against numpy's repeat / tile layout of the samples."""
+    rng = np.random.default_rng(2)
+    for nx, ny, nth in ((1, 1, 1), (6, 1, 20), (3, 4, 5)):
+        xs, ys, ths = rng.normal(size=nx), rng.normal(size=ny), rng.normal(size=nth)
+        want = np.column_stack(
+            [np.repeat(xs, ny * nth), np.tile(np.repeat(ys, nth), nx), np.tile(ths, nx * ny)]
+        )
+        assert sample_grid(xs, ys, ths).tobytes() == want.tobytes()

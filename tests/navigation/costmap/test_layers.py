@@ -227,6 +227,16 @@ def test_footprint_clearing_and_overwrite_combination(map10: np.ndarray) -> None
     assert cm.get_cost(5, 8) == FREE_SPACE  # known free along the ray
 
 
+@pytest.mark.parametrize("bad", [math.nan, math.inf, -math.inf])
+def test_an_observation_seen_from_a_non_finite_origin_is_refused(bad: float) -> None:
+    layer = _obstacle_costmap().plugin("obstacle_layer")
+    for k in range(3):
+        origin = [0.5, 0.5, 0.1]
+        origin[k] = bad
+        with pytest.raises(CostmapError, match="sensor origin is not finite"):
+            layer.add_observation("scan", origin, [[3.5, 1.5, 0.2]], 0.0, 0.0)  # type: ignore[attr-defined]
+
+
 def test_obstacles_move_with_the_rolling_window() -> None:
     lc = layered(
         {"rolling_window": True, "width": 6.0, "height": 6.0, "resolution": 1.0,

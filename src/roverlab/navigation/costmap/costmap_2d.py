@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import math
 
+import numba
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -194,14 +195,34 @@ class Costmap2D:
         Returns:
             False (and changes nothing) if a vertex lies off the map, as costmap_2d.
         """
-        pts = np.asarray(polygon, dtype=np.float64).reshape(-1, 2)
+        pts = np.ascontiguousarray(np.asarray(polygon, dtype=np.float64).reshape(-1, 2))
         if len(pts) < 3:
             return False
-        cells = np.empty((len(pts), 2), dtype=np.int64)
-        for k, (wx, wy) in enumerate(pts):
-            c = self.world_to_map(float(wx), float(wy))
-            if c is None:
-                return False
-            cells[k] = c
-        convex_fill(self.costs, cells, int(cost))
-        return True
+        return _fill_world_polygon(
+            self.costs, pts, self.origin_x, self.origin_y, self.resolution, int(cost)
+        )
+
+
+@numba.njit(cache=True, nogil=True)
+def _fill_world_polygon(
+    costs: NDArray[np.uint8], pts: NDArray[np.float64], ox: float, oy: float, res: float,
+    value: int,
+) -> bool:  # fmt: skip
+    """:meth:`Costmap2D.set_convex_polygon_cost` in one compiled call: each vertex's cell
+    as :meth:`Costmap2D.world_to_map` gives it (False, nothing changed, when one is off
+    the map), then :func:`convex_fill`."""
+    h, w = costs.shape
+    cells = np.empty((pts.shape[0], 2), dtype=np.int64)
+    for k in range(pts.shape[0]):
+        wx = pts[k, 0]
+        wy = pts[k, 1]
+        if wx < ox or wy < oy:
+            return False
+        mx = int((wx - ox) / res)
+        my = int((wy - oy) / res)
+        if not (mx < w and my < h):
+            return False
+        cells[k, 0] = mx
+        cells[k, 1] = my
+    convex_fill(costs, cells, value)
+    return True

@@ -12,6 +12,7 @@ import ast
 import math
 from typing import Any
 
+import numba
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -108,5 +109,15 @@ def footprint_radii(footprint: ArrayLike) -> tuple[float, float]:
 def transform_footprint(x: float, y: float, yaw: float, footprint: ArrayLike) -> FloatArray:
     """The footprint placed at robot pose ``(x, y, yaw)`` in the global frame."""
     pts = np.asarray(footprint, dtype=np.float64).reshape(-1, 2)
-    c, s = math.cos(yaw), math.sin(yaw)
-    return np.column_stack([x + pts[:, 0] * c - pts[:, 1] * s, y + pts[:, 0] * s + pts[:, 1] * c])
+    return _place(pts, float(x), float(y), math.cos(yaw), math.sin(yaw))
+
+
+@numba.njit(cache=True, nogil=True)
+def _place(pts: FloatArray, x: float, y: float, c: float, s: float) -> FloatArray:
+    """``x + px c - py s``, ``y + px s + py c`` of each point, in numpy's order of the
+    operations (the same values; one compiled call instead of six array operations)."""
+    out = np.empty((pts.shape[0], 2))
+    for k in range(pts.shape[0]):
+        out[k, 0] = x + pts[k, 0] * c - pts[k, 1] * s
+        out[k, 1] = y + pts[k, 0] * s + pts[k, 1] * c
+    return out

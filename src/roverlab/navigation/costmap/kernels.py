@@ -384,7 +384,13 @@ def inflate(
     """
     h, w = master.shape
     flat = master.reshape(-1)
-    seen[:] = False
+    # a cell taken lies within ``radius`` of a seed of the window, a cell looked at one
+    # further: only those are cleared (not the whole grid, 640 000 cells for BARN's
+    # global costmap); ``seen`` elsewhere is never read
+    rx0 = max(0, x0 - radius - 1)
+    rx1 = min(w, xn + radius + 1)
+    for j in range(max(0, y0 - radius - 1), min(h, yn + radius + 1)):
+        seen[j * w + rx0 : j * w + rx1] = False
     bin_head[:nbins] = -1
     bin_tail[:nbins] = -1
     cap = node_cell.shape[0]
@@ -410,11 +416,11 @@ def inflate(
             if not seen[idx]:
                 seen[idx] = True
                 taken += 1
-                mx = idx % w
                 my = idx // w
+                mx = idx - my * w
                 src = node_src[k]
-                sx = src % w
                 sy = src // w
+                sx = src - sy * w
                 cost = cost_of[abs(mx - sx), abs(my - sy)]
                 old = flat[idx]
                 if old == NO_INFO and (
@@ -423,26 +429,32 @@ def inflate(
                     flat[idx] = cost
                 else:
                     flat[idx] = max(old, cost)
-                for nb in range(4):
+                for nb in range(4):  # the neighbour's cell from this one's: no division
+                    nx = mx
+                    ny = my
                     if nb == 0:
                         if mx == 0:
                             continue
                         nidx = idx - 1
+                        nx = mx - 1
                     elif nb == 1:
                         if my == 0:
                             continue
                         nidx = idx - w
+                        ny = my - 1
                     elif nb == 2:
                         if mx == w - 1:
                             continue
                         nidx = idx + 1
+                        nx = mx + 1
                     else:
                         if my == h - 1:
                             continue
                         nidx = idx + w
+                        ny = my + 1
                     if seen[nidx]:
                         continue
-                    nb_bin = bin_of[abs(nidx % w - sx), abs(nidx // w - sy)]
+                    nb_bin = bin_of[abs(nx - sx), abs(ny - sy)]
                     if nb_bin < 0 or nn >= cap:
                         continue
                     node_cell[nn] = nidx

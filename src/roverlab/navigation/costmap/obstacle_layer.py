@@ -25,6 +25,7 @@ same as if projected on arrival; ROS projects every scan as it comes).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -201,7 +202,7 @@ class ObservationBuffer:
         the cloud: it is called when an update first uses the observation (never, when a
         newer one replaces it first)."""
         o = np.asarray(origin, dtype=np.float64).reshape(3)
-        if not np.isfinite(o).all():
+        if not (math.isfinite(o[0]) and math.isfinite(o[1]) and math.isfinite(o[2])):
             raise CostmapError(f"observation {self.params.name}: sensor origin is not finite")
         if callable(points):
             obs: Observation | _Pending = _Pending(o, points, float(stamp_s))

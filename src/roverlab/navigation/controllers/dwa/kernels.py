@@ -29,11 +29,13 @@ import numba
 import numpy as np
 from numpy.typing import NDArray
 
+from roverlab.navigation.controllers.dwa.rollouts import rollout, shared_rollout
 from roverlab.navigation.costmap.kernels import cells_cost, footprint_cells
 
 __all__ = [
     "first_known_stretch",
     "rollout",
+    "sample_grid",
     "score_rollouts",
     "target_distance",
     "target_distance_window",
@@ -79,8 +81,11 @@ def target_distance_window(
     h, w = costs.shape
     size = h * w
     pw = w + 2
+    # state & 3: 0 free and unseen, 1 an obstacle unseen, 2 seen (or the border), 3 reached
+    # and to be expanded; + 4: inside the window grown by one cell (its expansion is
+    # counted down in ``pending``; no division per cell to find it out)
     state = np.full((h + 2) * pw, 2, dtype=np.uint8)
-    dist = np.full((h + 2) * pw, size + 1, dtype=np.int64)
+    dist = np.full((h + 2) * pw, size + 1, dtype=np.int32)
     # the window grown by one cell, clipped to the grid (bordered coordinates)
     gx0 = max(window[0] - 1, 0) + 1
     gy0 = max(window[1] - 1, 0) + 1
@@ -91,34 +96,34 @@ def target_distance_window(
         row = (y + 1) * pw + 1
         inside_y = gy0 <= y + 1 <= gy1
         for x in range(w):
+            inside = inside_y and gx0 <= x + 1 <= gx1
             if costs[y, x] >= INSCRIBED:  # inscribed, lethal, unknown
-                state[row + x] = 1
+                state[row + x] = 5 if inside else 1
+            elif inside:
+                state[row + x] = 4
+                pending += 1
             else:
                 state[row + x] = 0
-                if inside_y and gx0 <= x + 1 <= gx1:
-                    pending += 1
     queue = np.empty(size + seeds.shape[0], dtype=np.int64)
     qh = 0
     qt = 0
     for k in range(seeds.shape[0]):
-        sx = seeds[k, 0] + 1
-        sy = seeds[k, 1] + 1
-        idx = sy * pw + sx
-        if state[idx] == 1 and gy0 <= sy <= gy1 and gx0 <= sx <= gx1:
+        idx = (seeds[k, 1] + 1) * pw + seeds[k, 0] + 1
+        st = state[idx]
+        if st == 5:
             pending += 1  # a seed on an obstacle is expanded too (a free one is counted)
-        state[idx] = 3  # reached, to be expanded
+        if st & 3 != 3:
+            state[idx] = 3 | (st & 4)  # reached, to be expanded
         dist[idx] = 0
         queue[qt] = idx
         qt += 1
     while qh < qt and pending > 0:
         cur = queue[qh]
         qh += 1
-        if state[cur] == 3:
+        st = state[cur]
+        if st & 3 == 3:
             state[cur] = 2
-            cy = cur // pw
-            cx = cur - cy * pw
-            if gy0 <= cy <= gy1 and gx0 <= cx <= gx1:
-                pending -= 1
+            pending -= st >> 2
         d = dist[cur] + 1
         for nb in range(4):
             if nb == 0:
@@ -129,14 +134,14 @@ def target_distance_window(
                 n = cur - pw
             else:
                 n = cur + pw
-            st = state[n]
+            st = state[n] & 3
             if st >= 2:
                 continue
             if st == 1:
                 state[n] = 2
                 dist[n] = size
                 continue
-            state[n] = 3  # reached, to be expanded
+            state[n] = state[n] | 3  # reached, to be expanded
             dist[n] = d
             queue[qt] = n
             qt += 1
@@ -194,89 +199,20 @@ def first_known_stretch(
 
 
 @_jit
-def rollout(
-    pos: NDArray[np.float64],
-    vel: NDArray[np.float64],
-    target: NDArray[np.float64],
-    sim_time: float,
-    sim_granularity: float,
-    angular_sim_granularity: float,
-    continued_acceleration: bool,
-    acc: NDArray[np.float64],
-    extra_time: float,
-    out: NDArray[np.float64],
-) -> tuple[int, int, float]:
-    """SimpleTrajectoryGenerator's ``generateTrajectory`` for one velocity sample.
-
-    Writes the poses (from the current pose, ``num_steps`` of them) to ``out``, followed by
-    the poses of ``extra_time`` more seconds at the same velocity (with five columns, each
-    pose's ``cos(th)`` and ``sin(th)`` too). Returns ``(num_steps, extra_steps, dt)``;
-    ``num_steps`` 0 if the sample gives no trajectory.
-    """
-    vmag = math.hypot(target[0], target[1])
-    num = int(
-        math.ceil(
-            max(
-                vmag * sim_time / sim_granularity,
-                abs(target[2]) * sim_time / angular_sim_granularity,
-            )
-        )
-    )
-    if num == 0:
-        return 0, 0, 0.0
-    dt = sim_time / num
-    extra = int(math.ceil(extra_time / dt - 1e-9)) if extra_time > 0 else 0
-    cap = out.shape[0]
-    if num + extra > cap:
-        extra = max(0, cap - num)
-        num = min(num, cap)
-    x = pos[0]
-    y = pos[1]
-    th = pos[2]
-    vx = target[0]
-    vy = target[1]
-    vth = target[2]
-    if continued_acceleration:
-        vx, vy, vth = _accelerate(target, vel[0], vel[1], vel[2], acc, dt)
-    trig = out.shape[1] >= 5
-    for i in range(num + extra):
-        c = math.cos(th)
-        s = math.sin(th)
-        out[i, 0] = x
-        out[i, 1] = y
-        out[i, 2] = th
-        if trig:
-            out[i, 3] = c
-            out[i, 4] = s
-        if continued_acceleration and i < num:
-            vx, vy, vth = _accelerate(target, vx, vy, vth, acc, dt)
-        if vy != 0.0:
-            x += (vx * c + vy * math.cos(math.pi / 2 + th)) * dt
-            y += (vx * s + vy * math.sin(math.pi / 2 + th)) * dt
-        else:  # the same values (a zero's sign aside, which nothing reads)
-            x += vx * c * dt
-            y += vx * s * dt
-        th += vth * dt
-    return num, extra, dt
-
-
-@_jit
-def _accelerate(
-    target: NDArray[np.float64],
-    vx: float,
-    vy: float,
-    vth: float,
-    acc: NDArray[np.float64],
-    dt: float,
-) -> tuple[float, float, float]:
-    out = np.empty(3)
-    cur = (vx, vy, vth)
-    for i in range(3):
-        if cur[i] < target[i]:
-            out[i] = min(target[i], cur[i] + acc[i] * dt)
-        else:
-            out[i] = max(target[i], cur[i] - acc[i] * dt)
-    return out[0], out[1], out[2]
+def sample_grid(
+    xs: NDArray[np.float64], ys: NDArray[np.float64], ths: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """Every ``(x, y, th)`` of the three velocity samplings, ``th`` fastest, then ``y``."""
+    out = np.empty((xs.shape[0] * ys.shape[0] * ths.shape[0], 3))
+    k = 0
+    for x in xs:
+        for y in ys:
+            for th in ths:
+                out[k, 0] = x
+                out[k, 1] = y
+                out[k, 2] = th
+                k += 1
+    return out
 
 
 @_jit
@@ -480,7 +416,13 @@ def score_rollouts(
     twirl_s = scales[5]
     occ_s = scales[0]
     nk = samples.shape[0]
-    traj = np.empty((8, 5))
+    cap = 8
+    for k in range(nk):
+        cap = max(cap, _rollout_cap(samples[k, 0], samples[k, 1], samples[k, 2], gen))
+    traj = np.empty((cap, 5))
+    keys = np.empty((nk, 2))
+    nkeys = np.zeros(1, dtype=np.int64)
+    heads = np.empty((nk, cap, 3))
     buf = np.empty((w + h + 4, 2), dtype=np.int64)
     partial = np.empty(nk)
     for k in range(nk):
@@ -490,11 +432,8 @@ def score_rollouts(
         if not _gen_ok(vx, vy, vth, gen):
             out[k] = -100.0
             continue
-        need = _rollout_cap(vx, vy, vth, gen)
-        if traj.shape[0] < need:
-            traj = np.empty((need, 5))
-        num, _extra, _dt = rollout(
-            pos, vel, samples[k], gen[0], gen[1], gen[2], continued_acceleration, acc, 0.0, traj
+        num, _extra = shared_rollout(
+            k, samples, pos, vel, gen, acc, continued_acceleration, 0.0, keys, nkeys, heads, traj
         )
         if num == 0:
             out[k] = -100.0
@@ -540,11 +479,8 @@ def score_rollouts(
             continue
         vx = samples[k, 0]
         vy = samples[k, 1]
-        need = _rollout_cap(vx, vy, samples[k, 2], gen)
-        if traj.shape[0] < need:
-            traj = np.empty((need, 5))
-        num, extra, _dt = rollout(
-            pos, vel, samples[k], gen[0], gen[1], gen[2], continued_acceleration, acc, gen[6],
+        num, extra = shared_rollout(
+            k, samples, pos, vel, gen, acc, continued_acceleration, gen[6], keys, nkeys, heads,
             traj,
         )  # fmt: skip
         vmag = math.hypot(vx, vy)

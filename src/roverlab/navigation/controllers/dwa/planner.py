@@ -56,6 +56,7 @@ from roverlab.navigation.controllers.dwa.in_place import (
 )
 from roverlab.navigation.controllers.dwa.kernels import (
     first_known_stretch,
+    sample_grid,
     score_rollouts,
     target_distance_window,
 )
@@ -104,6 +105,33 @@ def _adjust_resolution(plan: NDArray[np.float64], resolution: float) -> NDArray[
     j = np.arange(len(seg)) - np.repeat(np.cumsum(steps) - steps, steps)
     inner = a[seg] + j[:, None] * delta[seg] / steps[seg, None]
     return np.concatenate([inner, xy[-1:]])
+
+
+def _forward_window(
+    pose: SE2, cm: Costmap2D, reach: float, ahead: float, square: NDArray[np.int64]
+) -> NDArray[np.int64]:
+    """``square`` (cells) cut to the cells a forward rollout reads: with constant
+    velocities (``use_dwa``), no lateral motion, ``vx >= 0`` and at most half a turn over
+    ``sim_time``, every pose of a rollout lies ahead of the robot or beside it (a sum of
+    ``v dt (cos j a, sin j a)``, ``j a < pi``, has a projection on the first heading
+    ``>= 0``), and the goal-front point at most ``forward_point_distance`` behind: the
+    robot-frame box ``[-ahead, reach] x [-reach, reach]`` (m), turned to the map, plus
+    two cells. A read outside still falls back to the whole waves."""
+    c, s = math.cos(pose.theta), math.sin(pose.theta)
+    back = max(ahead, 0.0)
+    xs = [pose.x + u * c - v * s for u in (-back, reach) for v in (-reach, reach)]
+    ys = [pose.y + u * s + v * c for u in (-back, reach) for v in (-reach, reach)]
+    res = cm.resolution
+    box = [
+        math.floor((min(xs) - cm.origin_x) / res) - 2,
+        math.floor((min(ys) - cm.origin_y) / res) - 2,
+        math.floor((max(xs) - cm.origin_x) / res) + 2,
+        math.floor((max(ys) - cm.origin_y) / res) + 2,
+    ]
+    return np.array(
+        [max(box[0], square[0]), max(box[1], square[1]), min(box[2], square[2]),
+         min(box[3], square[3])], dtype=np.int64,
+    )  # fmt: skip
 
 
 def _first_known_stretch(plan: NDArray[np.float64], cm: Costmap2D) -> NDArray[np.int64] | None:
@@ -285,7 +313,14 @@ class DWAPlanner(EscapeMixin):
         r = math.ceil(reach / cm.resolution) + 2
         cx = math.floor((pose.x - cm.origin_x) / cm.resolution)
         cy = math.floor((pose.y - cm.origin_y) / cm.resolution)
-        return np.array([cx - r, cy - r, cx + r, cy + r], dtype=np.int64)
+        window = np.array([cx - r, cy - r, cx + r, cy + r], dtype=np.int64)
+        if (
+            p.use_dwa and not self.escaping and p.min_vel_x >= 0.0 and v.vx >= 0.0
+            and p.y_limits == (0.0, 0.0) and v.vy == 0.0
+            and max(abs(p.max_vel_theta), abs(v.wz)) * p.sim_time <= math.pi
+        ):  # fmt: skip
+            window = _forward_window(pose, cm, reach, p.forward_point_distance, window)
+        return window
 
     def _waves(self, cm: Costmap2D, window: NDArray[np.int64]) -> None:
         """The three map grids (``MapGrid::computeTargetDistance`` from ``self._seeds``),
@@ -371,10 +406,7 @@ class DWAPlanner(EscapeMixin):
         xs = velocity_iterator(lo[0], hi[0], nx)
         ys = velocity_iterator(lo[1], hi[1], ny)
         ths = velocity_iterator(lo[2], hi[2], nth)
-        grid = np.empty((len(xs) * len(ys) * len(ths), 3))  # every (x, y, th), th fastest
-        grid[:, 0] = np.repeat(xs, len(ys) * len(ths))
-        grid[:, 1] = np.tile(np.repeat(ys, len(ths)), len(xs))
-        grid[:, 2] = np.tile(ths, len(xs) * len(ys))
+        grid = sample_grid(np.array(xs), np.array(ys), np.array(ths))
         if rotations:  # TrajectoryPlanner's, whatever min_vel_x is
             grid = np.concatenate([grid, in_place_samples(lo[2], hi[2], nth, p.min_vel_theta)])
         return np.ascontiguousarray(grid, dtype=np.float64)
