@@ -359,10 +359,9 @@ def test_band_turning_back_sees_the_posts_behind_the_robot() -> None:
     # a plan straight ahead keeps TEB's filter: the cells behind are left out
     ahead = np.column_stack([np.linspace(4.0, 2.0, 21), np.full(21, 4.0), np.zeros(21)])
     teb.compute_velocity(pose, Velocity2D(), ahead, cm)
-    behind = (teb.obstacles[:, 0] - pose.x) * math.cos(pose.theta) < 0
-    far = (
-        np.hypot(*(teb.obstacles - [pose.x, pose.y]).T) > params.costmap_obstacles_behind_robot_dist
-    )
+    rel = teb.obstacles - [pose.x, pose.y]
+    behind = rel @ [math.cos(pose.theta), math.sin(pose.theta)] < 0
+    far = np.hypot(rel[:, 0], rel[:, 1]) > params.costmap_obstacles_behind_robot_dist
     assert not (behind & far).any() and 0 < len(teb.obstacles) < len(_BEHIND_CELLS)
 
 
