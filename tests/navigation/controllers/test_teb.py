@@ -13,6 +13,7 @@ from roverlab.geometry import SE2
 from roverlab.navigation.controllers import FootprintModel, TebParams, TebPlanner, Velocity2D
 from roverlab.navigation.controllers.teb import TimedElasticBand
 from roverlab.navigation.controllers.teb.kernels import associate_obstacles, robot_distance
+from roverlab.navigation.controllers.teb.obstacles import costmap_obstacles
 from roverlab.navigation.costmap import Costmap2D, footprint_from_radius, pad_footprint
 from roverlab.navigation.errors import NavigationParamsError, NoValidControlError
 from roverlab.navigation.planners import NavfnPlanner
@@ -183,7 +184,7 @@ def test_work_per_cycle_is_bounded_by_the_band_not_the_costmap(teb_params: TebPa
     teb = TebPlanner(teb_params, footprint=FOOT)
     cm = _open()
     cm.costs[:, ::2] = 254  # a costmap full of lethal cells: 900 of them
-    teb.obstacles = teb._costmap_obstacles(SE2(0.5, 1.5, 0.0), cm)
+    teb.obstacles = costmap_obstacles(teb.params, SE2(0.5, 1.5, 0.0), cm, np.zeros((0, 3)))
     teb._obstacle_tree = cKDTree(teb.obstacles)
     band = np.column_stack([np.linspace(0.5, 1.5, 11), np.full(11, 1.5), np.zeros(11)])
     near = teb._near_obstacles(band)
@@ -313,6 +314,55 @@ def test_jackal_band_turning_in_a_gap_keeps_the_padded_corners_off_the_posts() -
     old = replace(params, footprint_model=FootprintModel("line", (-0.1, 0.0, 0.1, 0.0)))
     with pytest.raises(NoValidControlError, match="not feasible"):
         TebPlanner(old, footprint=padded).compute_velocity(pose, Velocity2D(), plan, cm)
+
+
+# BARN world_176 at 0.5 m/s: the local costmap's lethal cells within 1.5 m of the robot
+# beside and behind it (the posts the band passes when it turns back), the robot's pose
+# and every 4th point of navfn's plan (3.2 m)
+_BEHIND_CELLS = [
+    (84, 51), (84, 54), (84, 57), (85, 51), (85, 52), (85, 54), (85, 55), (85, 57), (85, 58),
+    (85, 59), (86, 52), (86, 55), (86, 56), (86, 58), (86, 59), (87, 57), (87, 58), (87, 90),
+    (88, 57), (88, 58), (88, 59), (88, 86), (88, 87), (88, 89), (88, 90), (88, 91), (89, 58),
+    (89, 59), (89, 86), (89, 89), (90, 58), (90, 75), (91, 74), (91, 75), (91, 76), (91, 77),
+    (91, 78), (91, 79), (91, 83), (91, 84), (91, 86), (91, 87), (92, 55), (92, 56), (92, 76),
+    (92, 79), (92, 83), (92, 86), (93, 55), (93, 72), (94, 71), (94, 72), (94, 73), (95, 74),
+    (102, 60), (103, 61),
+]  # fmt: skip
+_BEHIND_PLAN = [
+    (4.03, 4.03), (4.02, 3.91), (4.02, 3.81), (4.01, 3.71), (4.0, 3.62), (3.98, 3.52),
+    (3.96, 3.42), (3.94, 3.32), (3.91, 3.22), (3.89, 3.13), (3.87, 3.03), (3.84, 2.93),
+    (3.84, 2.83), (3.84, 2.73), (3.85, 2.63), (3.84, 2.53), (3.84, 2.43), (3.83, 2.33),
+    (3.85, 2.24), (3.86, 2.14), (3.92, 2.06), (3.99, 1.99), (4.07, 1.94), (4.15, 1.89),
+    (4.22, 1.9), (4.32, 1.92), (4.42, 1.92), (4.52, 1.92), (4.62, 1.93), (4.71, 1.95),
+    (4.81, 1.97), (4.91, 1.99),
+]  # fmt: skip
+
+
+def test_band_turning_back_sees_the_posts_behind_the_robot() -> None:
+    """BARN world_176 at 0.5 m/s: the robot faces -x and navfn's plan turns back past
+    posts behind it. TEB leaves out a cell behind the robot and farther than
+    costmap_obstacles_behind_robot_dist (the Jackal file: 1.0 m), so the band, initialised
+    from the plan, ran through those posts, its feasibility check (the costmap's padded
+    footprint) rejected it every cycle, and the robot stood still 15 s until move_base's
+    recoveries (44.8 s for the world). The cells near the plan where it runs behind the
+    robot are the band's obstacles too: it turns back clear of the posts."""
+    params = replace(_jackal(), max_vel_x=0.5)
+    cm = Costmap2D(size_x=160, size_y=160, resolution=0.05)
+    for ix, iy in _BEHIND_CELLS:
+        cm.costs[iy, ix] = 254
+    plan = np.column_stack([np.array(_BEHIND_PLAN), np.zeros(len(_BEHIND_PLAN))])
+    pose = SE2(4.047, 4.015, -3.1139)
+    teb = TebPlanner(params, footprint=pad_footprint(_BODY, 0.1))
+    cmd = teb.compute_velocity(pose, Velocity2D(), plan, cm)
+    assert cmd.vx > 0 and cmd.wz == pytest.approx(params.max_vel_theta)  # turning left
+    assert len(teb.obstacles) == len(_BEHIND_CELLS)
+    # a plan straight ahead keeps TEB's filter: the cells behind are left out
+    ahead = np.column_stack([np.linspace(4.0, 2.0, 21), np.full(21, 4.0), np.zeros(21)])
+    teb.compute_velocity(pose, Velocity2D(), ahead, cm)
+    rel = teb.obstacles - [pose.x, pose.y]
+    behind = rel @ [math.cos(pose.theta), math.sin(pose.theta)] < 0
+    far = np.hypot(rel[:, 0], rel[:, 1]) > params.costmap_obstacles_behind_robot_dist
+    assert not (behind & far).any() and 0 < len(teb.obstacles) < len(_BEHIND_CELLS)
 
 
 def test_failure_detector_flags_a_robot_turning_back_and_forth() -> None:

@@ -12,7 +12,8 @@ Per control cycle, as TebLocalPlannerROS::computeVelocityCommands:
 * TEB's oscillation recovery (:mod:`.recovery`) may prefer a turning direction;
 * every lethal cell of the local costmap is a point obstacle
   (``include_costmap_obstacles``), except those behind the robot farther than
-  ``costmap_obstacles_behind_robot_dist``;
+  ``costmap_obstacles_behind_robot_dist`` (unless the local plan runs behind the robot
+  near them: roverlab's addition, so a band turning back sees the posts it passes);
 * the band is initialised from the local plan (or warm-started: passed poses pruned, start
   and goal updated; re-initialised when the goal moved more than
   ``force_reinit_new_goal_dist`` / ``_angular``), then ``no_outer_iterations`` times:
@@ -46,6 +47,7 @@ from roverlab.navigation.controllers.teb.kernels import (
     build_structure,
     evaluate,
 )
+from roverlab.navigation.controllers.teb.obstacles import association_reach, costmap_obstacles
 from roverlab.navigation.controllers.teb.params import TebParams
 from roverlab.navigation.controllers.teb.recovery import OscillationRecovery
 from roverlab.navigation.controllers.teb.solver import band_order, levenberg_marquardt
@@ -62,17 +64,6 @@ _DT_MIN = 1e-3  # floor of every time difference after a solve
 #: force-included obstacles kept per pose (the closest): bounds the edges a pose gets
 #: when the obstacles are costmap cells, a dozen of them per post or wall stretch
 _MAX_FORCED_PER_POSE = 8
-
-
-def _model_reach(kind: str, values: NDArray[np.float64]) -> float:
-    """How far the robot model reaches from the pose (m): 0 for a point."""
-    if kind == "circular":
-        return float(values[0])
-    if kind == "two_circles":
-        return float(max(abs(values[0]) + values[1], abs(values[2]) + values[3]))
-    if kind in ("line", "polygon"):
-        return float(np.hypot(values[0::2], values[1::2]).max())
-    return 0.0
 
 
 def _prune(pose: SE2, plan: NDArray[np.float64], dist_behind: float) -> NDArray[np.float64]:
@@ -208,18 +199,6 @@ class TebPlanner:
         )
 
     # ------------------------------------------------------------------ obstacles
-    def _costmap_obstacles(self, pose: SE2, cm: Costmap2D) -> NDArray[np.float64]:
-        if not self.params.include_costmap_obstacles:
-            return np.zeros((0, 2))
-        ys, xs = np.nonzero(cm.costs == LETHAL_OBSTACLE)
-        obs = np.column_stack(
-            [cm.origin_x + (xs + 0.5) * cm.resolution, cm.origin_y + (ys + 0.5) * cm.resolution]
-        )
-        rel = obs - [pose.x, pose.y]
-        ahead = rel @ [math.cos(pose.theta), math.sin(pose.theta)]
-        far = np.hypot(rel[:, 0], rel[:, 1]) > self.params.costmap_obstacles_behind_robot_dist
-        return np.ascontiguousarray(obs[~((ahead < 0) & far)])
-
     def _near_obstacles(self, poses: NDArray[np.float64]) -> NDArray[np.float64]:
         """The obstacles within the association cutoff of some inner pose of the band (the
         only ones :func:`associate_obstacles` can pick), found in the cycle's k-d tree:
@@ -227,11 +206,9 @@ class TebPlanner:
         tree = self._obstacle_tree
         if tree is None or len(poses) < 3:
             return np.zeros((0, 2))
-        p = self.params
-        reach = p.min_obstacle_dist * max(
-            p.obstacle_association_cutoff_factor, p.obstacle_association_force_inclusion_factor
-        ) + _model_reach(p.footprint_model.type, p.footprint_model.as_array())
-        hits = tree.query_ball_point(poses[1:-1, :2], reach, return_sorted=False)
+        hits = tree.query_ball_point(
+            poses[1:-1, :2], association_reach(self.params), return_sorted=False
+        )
         idx = np.unique(np.concatenate([np.asarray(h, dtype=np.int64) for h in hits]))
         return np.ascontiguousarray(self.obstacles[idx])
 
@@ -564,7 +541,7 @@ class TebPlanner:
             local = np.vstack([local[:1], local])
         local[0] = pose.as_array()
         self.local_plan = local
-        self.obstacles = self._costmap_obstacles(pose, costmap)
+        self.obstacles = costmap_obstacles(p, pose, costmap, local)
         self._obstacle_tree = cKDTree(self.obstacles) if len(self.obstacles) else None
         if not p.optimization_activate:
             raise NoValidControlError("teb_local_planner: optimization_activate is false")
