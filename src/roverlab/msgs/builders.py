@@ -284,9 +284,31 @@ def laser_scan(
     intensities: Any,
 ) -> Any:
     """``sensor_msgs/LaserScan``: stamp, frame and the fields in ROS order."""
-    h = _header(sec, nanosec, frame_id)
-    m = _new(_LaserScan)
-    m.header = h
+    return _fill_laser_scan(
+        _new(_LaserScan), sec, nanosec, frame_id, angle_min, angle_max, angle_increment,
+        time_increment, scan_time, range_min, range_max, "ranges", ranges, intensities,
+    )  # fmt: skip
+
+
+def _fill_laser_scan(
+    m: Any,
+    sec: int,
+    nanosec: int,
+    frame_id: str,
+    angle_min: float,
+    angle_max: float,
+    angle_increment: float,
+    time_increment: float,
+    scan_time: float,
+    range_min: float,
+    range_max: float,
+    ranges_key: str,
+    ranges: Any,
+    intensities: Any,
+) -> Any:
+    """Every field of a new LaserScan ``m`` in ROS order; ``ranges`` is stored under
+    ``ranges_key`` (``_make`` for a :class:`DeferredLaserScan`'s function)."""
+    m.header = _header(sec, nanosec, frame_id)
     m.angle_min = angle_min
     m.angle_max = angle_max
     m.angle_increment = angle_increment
@@ -294,7 +316,7 @@ def laser_scan(
     m.scan_time = scan_time
     m.range_min = range_min
     m.range_max = range_max
-    m.ranges = ranges
+    m.__dict__[ranges_key] = ranges
     m.intensities = intensities
     m.__msgtype__ = _LASER_SCAN
     return m
@@ -350,17 +372,8 @@ def laser_scan_later(
 ) -> Any:
     """:func:`laser_scan` with ``ranges`` a function called when the field is first read
     (a :class:`DeferredLaserScan`)."""
-    h = _header(sec, nanosec, frame_id)
-    m = _new(DeferredLaserScan)
-    m.header = h
-    m.angle_min = angle_min
-    m.angle_max = angle_max
-    m.angle_increment = angle_increment
-    m.time_increment = time_increment
-    m.scan_time = scan_time
-    m.range_min = range_min
-    m.range_max = range_max
-    m.__dict__["_make"] = ranges
-    m.intensities = intensities
-    m.__msgtype__ = _LASER_SCAN
-    return m
+    return _fill_laser_scan(
+        _new(DeferredLaserScan), sec, nanosec, frame_id, angle_min, angle_max,
+        angle_increment, time_increment, scan_time, range_min, range_max, "_make", ranges,
+        intensities,
+    )  # fmt: skip
