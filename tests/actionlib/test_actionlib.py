@@ -374,10 +374,10 @@ def test_feedback_and_status_copies_match_the_factory_built_messages(ctx: Contex
     assert copy == tracker and copy is not tracker and copy.goal_id is not tracker.goal_id
 
 
-def test_a_feedback_dict_of_messages_is_what_from_dict_makes() -> None:
-    """``{"base_position": PoseStamped}`` (move_base's feedback) is built directly: the
-    same message as ``from_dict`` (the value kept, not copied); other dicts go through
-    ``from_dict`` with its checks."""
+def test_a_feedback_message_is_sent_as_given_and_a_dict_through_from_dict() -> None:
+    """A feedback message of the action's type (move_base builds its MoveBaseFeedback each
+    cycle) is sent as it is: the same message as ``from_dict`` makes of the dict, the
+    value kept, not copied; dicts go through ``from_dict`` with its checks."""
     from roverlab.actionlib import server as srv
     from roverlab.msgs import get_factory
     from roverlab.msgs.cdr import serialize
@@ -386,10 +386,11 @@ def test_a_feedback_dict_of_messages_is_what_from_dict_makes() -> None:
     pose = get_factory("geometry_msgs/msg/PoseStamped")(
         header={"frame_id": "map", "stamp": {"sec": 3}}, pose={"position": {"x": 1.5}}
     )
-    fast = srv._as_message({"base_position": pose}, feedback)
+    given = feedback.cls(base_position=pose)
+    fast = srv._as_message(given, feedback)
     plain = feedback.from_dict({"base_position": pose})
     assert type(fast) is type(plain) and serialize(fast) == serialize(plain)
-    assert fast.base_position is pose
+    assert fast is given and fast.base_position is pose
     nested = srv._as_message({"base_position": {"pose": {"position": {"y": 2.0}}}}, feedback)
     assert nested.base_position.pose.position.y == 2.0
     with pytest.raises(Exception, match="base_positon"):

@@ -22,7 +22,6 @@ from typing import Any
 from roverlab.actionlib.status import GoalIDGenerator, GoalStatus, status_name
 from roverlab.core import Node, QoSProfile, Time
 from roverlab.msgs import ActionType, get_action_type, get_factory
-from roverlab.msgs._store import STORE, FieldKind
 
 __all__ = ["ActionServer", "ServerGoalHandle"]
 
@@ -396,28 +395,5 @@ def _as_message(value: Any, factory: Any) -> Any:
     if isinstance(value, factory.cls):
         return value
     if isinstance(value, dict):
-        fields = _message_fields(factory.typename)
-        if (
-            fields is not None
-            and value.keys() == fields.keys()
-            and all(getattr(type(v), "__msgtype__", None) == fields[k] for k, v in value.items())
-        ):
-            # every field given as a message of its type (move_base's feedback, each
-            # cycle): what from_dict makes of it, the values kept as they are, unchecked
-            return factory.cls(**value)
         return factory.from_dict(value)
     raise TypeError(f"expected {factory.typename}, got {type(value).__name__}")
-
-
-_MESSAGE_FIELDS: dict[str, dict[str, str] | None] = {}
-
-
-def _message_fields(typename: str) -> dict[str, str] | None:
-    """``{field: message type}`` of a type whose fields are all messages (else None)."""
-    if typename not in _MESSAGE_FIELDS:
-        spec = STORE.spec(typename)
-        kinds = {f.kind for f in spec.fields}
-        _MESSAGE_FIELDS[typename] = (
-            {f.name: f.typename for f in spec.fields} if kinds == {FieldKind.MESSAGE} else None
-        )
-    return _MESSAGE_FIELDS[typename]

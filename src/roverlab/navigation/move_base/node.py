@@ -372,7 +372,7 @@ class MoveBase(Node):
                 sec, nsec, self.global_frame, float(gpose.x), float(gpose.y), 0.0,
                 0.0, 0.0, math.sin(half), math.cos(half),
             )  # fmt: skip
-            srv.publish_feedback({"base_position": fb})
+            srv.publish_feedback(srv.spec.Feedback.cls(base_position=fb))
             op = self._oscillation_pose
             if (
                 op is None
