@@ -170,6 +170,12 @@ class TebParams:
     max_samples: int = 500
     global_plan_overwrite_orientation: bool = True
     allow_init_with_backwards_motion: bool = False
+    #: roverlab's addition (0: off, as TEB): once every band has been "not feasible" for
+    #: this many seconds in a row, the band is initialised backwards (as with
+    #: ``allow_init_with_backwards_motion``) when the local goal lies behind the robot, so
+    #: a robot standing in a pocket it cannot turn in backs out along its plan instead of
+    #: waiting out move_base's ``controller_patience``
+    backwards_init_when_stuck: float = 0.0
     global_plan_viapoint_sep: float = -0.1
     via_points_ordered: bool = False
     max_global_plan_lookahead_dist: float = 3.0

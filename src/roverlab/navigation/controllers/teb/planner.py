@@ -164,6 +164,7 @@ class TebPlanner:
         self._cycles = 0  # control cycles: the oscillation recovery's clock
         self._preferred_rotdir = 0  # TEB's RotType: +1 left, -1 right, 0 none
         self._last_cmd = Velocity2D()
+        self._infeasible_cycles = 0  # control cycles in a row without a valid command
 
     @property
     def trajectory(self) -> NDArray[np.float64]:
@@ -456,6 +457,35 @@ class TebPlanner:
         return True
 
     # ------------------------------------------------------------------ command
+    def _backwards_when_stuck(
+        self, local: NDArray[np.float64], twist: Velocity2D, costmap: Costmap2D, spacing: float
+    ) -> bool:
+        """``backwards_init_when_stuck``: after that long without a feasible band, and with
+        the local goal behind the robot, a band initialised backwards, optimised and
+        checked like the first; True when it is feasible (it then stays the band)."""
+        p = self.params
+        if (
+            p.backwards_init_when_stuck <= 0
+            or p.allow_init_with_backwards_motion  # the first band was already one
+            or self._infeasible_cycles < p.backwards_init_when_stuck * p.controller_frequency
+        ):
+            return False
+        start, goal = local[0], local[-1]
+        if float((goal[:2] - start[:2]) @ [math.cos(start[2]), math.sin(start[2])]) >= 0:
+            return False  # ahead: the backwards guess gives the same band
+        band = self.band
+        band.clear()
+        band.init_from_plan(
+            local, p.max_vel_x, p.max_vel_theta, p.global_plan_overwrite_orientation,
+            p.min_samples, True, spacing,
+        )  # fmt: skip
+        try:
+            self._optimize(twist, p.free_goal_vel)
+        except (ValueError, TypeError, np.linalg.LinAlgError):
+            return False
+        finite = np.isfinite(band.poses).all() and np.isfinite(band.dts).all()
+        return bool(finite) and self._feasible(costmap)
+
     def _velocity_command(self) -> Velocity2D:
         p = self.params
         poses, dts = self.band.poses, self.band.dts
@@ -522,8 +552,10 @@ class TebPlanner:
             cmd = self._cycle(pose, twist, costmap, local, goal_idx)
         except NoValidControlError:
             self._last_cmd = Velocity2D()  # TEB's last_cmd_ is the zero it commands then
+            self._infeasible_cycles += 1
             raise
         self._last_cmd = cmd
+        self._infeasible_cycles = 0
         return cmd
 
     def _cycle(
@@ -547,6 +579,7 @@ class TebPlanner:
             raise NoValidControlError("teb_local_planner: optimization_activate is false")
         start, goal = local[0], local[-1]
         band = self.band
+        spacing = max((p.dt_ref - p.dt_hysteresis) * p.max_vel_x if p.teb_autosize else 0.0, 0.0)
         if band.is_init and (
             math.hypot(*(goal[:2] - band.poses[-1, :2])) < p.force_reinit_new_goal_dist
             and abs(wrap_angle(float(goal[2] - band.poses[-1, 2])))
@@ -555,10 +588,9 @@ class TebPlanner:
             band.update_and_prune(start, goal, p.min_samples)
         else:
             band.clear()
-            spacing = (p.dt_ref - p.dt_hysteresis) * p.max_vel_x if p.teb_autosize else 0.0
             band.init_from_plan(
                 local, p.max_vel_x, p.max_vel_theta, p.global_plan_overwrite_orientation,
-                p.min_samples, p.allow_init_with_backwards_motion, max(spacing, 0.0),
+                p.min_samples, p.allow_init_with_backwards_motion, spacing,
             )  # fmt: skip
         try:
             self._optimize(twist, p.free_goal_vel)
@@ -570,7 +602,9 @@ class TebPlanner:
         if not np.isfinite(band.poses).all() or not np.isfinite(band.dts).all():
             band.clear()
             raise NoValidControlError("teb_local_planner: the trajectory has diverged")
-        if not self._feasible(costmap):
+        if not self._feasible(costmap) and not self._backwards_when_stuck(
+            local, twist, costmap, spacing
+        ):
             band.clear()
             raise NoValidControlError("teb_local_planner: trajectory is not feasible")
         try:
