@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
+from roverlab.description import find_package
 from roverlab.navbench import BenchGrid, GoalRecord
 from roverlab.navbench.fixed import FixedConfig, barn_score, run_fixed
 from roverlab.navbench.report import draw
@@ -179,6 +180,21 @@ def test_live_episode_on_odometry_alone(tmp_path: Path) -> None:
     rows = list(csv.DictReader((tmp_path / "out" / "room.csv").open()))
     assert float(rows[-1]["x"]) > 2.4  # the driven path, ground truth
     assert Image.open(tmp_path / "out" / "room.png").size[0] > 100
+
+
+def test_teb_with_the_jackal_file_replans_while_it_drives(tmp_path: Path) -> None:
+    """The bundled Jackal TEB file sets move_base's planner_frequency (1 Hz, as
+    teb_local_planner_tutorials): BARN's launch loads no move_base_params.yaml, and with
+    move_base's default 0 the plan made from the start, before the posts were seen, was
+    kept until TEB failed. DWA with BARN's own files still plans once."""
+    teb_file = (
+        find_package("robot_navigation") / "param" / "Jackal" / "teb_local_planner_params.yaml"
+    )
+    teb, _ = run_fixed(replace(_room(tmp_path), planner="teb", teb_params=teb_file), write=False)
+    assert teb.status == "succeeded", teb.status
+    assert teb.record.planner_calls >= math.floor(teb.sim_time_s) - 1, (teb.record, teb.sim_time_s)
+    dwa, _ = run_fixed(_room(tmp_path), write=False)
+    assert dwa.status == "succeeded" and dwa.record.planner_calls == 1, dwa.record
 
 
 @pytest.mark.slow

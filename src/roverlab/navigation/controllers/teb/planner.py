@@ -29,6 +29,9 @@ Per control cycle, as TebLocalPlannerROS::computeVelocityCommands:
   to the limits.
 
 Failures raise :class:`NoValidControlError` and reset the band, as TEB clears its planner.
+roverlab's ``backwards_init_when_stuck`` (off by default): after that many seconds of
+infeasible bands, with the local goal behind the robot, a band initialised backwards is
+tried in the same cycle (a robot in a pocket it cannot turn in reverses out).
 """
 
 from __future__ import annotations
@@ -42,6 +45,7 @@ from scipy.spatial import cKDTree
 from roverlab.geometry import SE2, wrap_angle
 from roverlab.navigation.controllers.base import Velocity2D, angle_diff, as_plan, stopped
 from roverlab.navigation.controllers.teb.band import TimedElasticBand
+from roverlab.navigation.controllers.teb.feasibility import FootprintCheck
 from roverlab.navigation.controllers.teb.kernels import (
     associate_obstacles,
     build_structure,
@@ -51,9 +55,7 @@ from roverlab.navigation.controllers.teb.obstacles import association_reach, cos
 from roverlab.navigation.controllers.teb.params import TebParams
 from roverlab.navigation.controllers.teb.recovery import OscillationRecovery
 from roverlab.navigation.controllers.teb.solver import band_order, levenberg_marquardt
-from roverlab.navigation.costmap.costmap_2d import LETHAL_OBSTACLE, Costmap2D
-from roverlab.navigation.costmap.footprint import footprint_radii
-from roverlab.navigation.costmap.kernels import bresenham, line_cost
+from roverlab.navigation.costmap.costmap_2d import Costmap2D
 from roverlab.navigation.errors import InvalidPathError, NoValidControlError
 
 __all__ = ["TebPlanner"]
@@ -145,10 +147,9 @@ class TebPlanner:
 
     def __init__(self, params: TebParams | None = None, *, footprint: ArrayLike = ()) -> None:
         self.params = params or TebParams()
-        self.footprint = np.ascontiguousarray(
-            np.asarray(footprint, dtype=np.float64).reshape(-1, 2)
-        )
-        self.inscribed_radius = footprint_radii(self.footprint)[0]
+        self._check = FootprintCheck(footprint)
+        self.footprint = self._check.footprint
+        self.inscribed_radius = self._check.inscribed_radius
         self.band = TimedElasticBand()
         self.obstacles: NDArray[np.float64] = np.zeros((0, 2))
         self._obstacle_tree: cKDTree | None = None
@@ -159,7 +160,6 @@ class TebPlanner:
         self._plan: NDArray[np.float64] = np.zeros((0, 3))
         self._last_pose: SE2 | None = None
         self._last_twist = Velocity2D()
-        self._line_buf = np.empty((4096, 2), dtype=np.int64)
         self._recovery = OscillationRecovery(self.params)
         self._cycles = 0  # control cycles: the oscillation recovery's clock
         self._preferred_rotdir = 0  # TEB's RotType: +1 left, -1 right, 0 none
@@ -382,79 +382,9 @@ class TebPlanner:
             mult *= p.weight_adapt_factor
 
     # ------------------------------------------------------------------ feasibility
-    def _blocked(self, cm: Costmap2D, x: float, y: float, th: float) -> bool:
-        """CostmapModel::footprintCost == -1 (a lethal cell under the footprint's outline;
-        for fewer than three points, the centre cell lethal or inscribed)."""
-        c = cm.world_to_map(x, y)
-        if c is None:
-            return False
-        fp = self.footprint
-        if len(fp) < 3:
-            return cm.get_cost(*c) >= 253 and cm.get_cost(*c) != 255
-        ct, st = math.cos(th), math.sin(th)
-        pts = np.column_stack(
-            [x + fp[:, 0] * ct - fp[:, 1] * st, y + fp[:, 0] * st + fp[:, 1] * ct]
-        )
-        cells = []
-        for wx, wy in pts:
-            cc = cm.world_to_map(float(wx), float(wy))
-            if cc is None:
-                return False
-            cells.append(cc)
-        need = cm.size_x + cm.size_y + 4
-        if self._line_buf.shape[0] < need:
-            self._line_buf = np.empty((need, 2), dtype=np.int64)
-        for k in range(len(cells)):
-            a, b = cells[k], cells[(k + 1) % len(cells)]
-            # a lethal or unknown cell on the edge; only lethal makes it infeasible
-            if line_cost(cm.costs, a[0], a[1], b[0], b[1], self._line_buf) < 0 and (
-                self._lethal_on_line(cm, a, b)
-            ):
-                return True
-        return False
-
-    def _lethal_on_line(self, cm: Costmap2D, a: tuple[int, int], b: tuple[int, int]) -> bool:
-        n = bresenham(a[0], a[1], b[0], b[1], 1 << 30, self._line_buf)
-        cells = self._line_buf[:n]
-        return bool(np.any(cm.costs[cells[:, 1], cells[:, 0]] == LETHAL_OBSTACLE))
-
     def _feasible(self, cm: Costmap2D) -> bool:
-        """TEB's ``isTrajectoryFeasible`` over the first ``feasibility_check_no_poses``."""
-        p = self.params
-        poses = self.band.poses
-        look = p.feasibility_check_no_poses
-        if look < 0 or look >= len(poses):
-            look = len(poses) - 1
-        if p.feasibility_check_lookahead_distance > 0:
-            # as TEB: the pose before the first one farther than the distance is the last
-            # checked (this replaces feasibility_check_no_poses, as in TEB's code)
-            far = np.hypot(poses[1:, 0] - poses[0, 0], poses[1:, 1] - poses[0, 1])
-            beyond = np.nonzero(far > p.feasibility_check_lookahead_distance)[0]
-            if len(beyond):
-                look = int(beyond[0])
-        step = self.inscribed_radius if self.inscribed_radius > 0 else cm.resolution
-        for i in range(look + 1):
-            if self._blocked(cm, *map(float, poses[i])):
-                return False
-            if i < look:
-                rot = wrap_angle(float(wrap_angle(poses[i + 1, 2]) - wrap_angle(poses[i, 2])))
-                dd = poses[i + 1, :2] - poses[i, :2]
-                dist = float(np.hypot(*dd))
-                if abs(rot) > p.min_resolution_collision_check_angular or dist > step:
-                    k = (
-                        max(
-                            math.ceil(abs(rot) / p.min_resolution_collision_check_angular),
-                            math.ceil(dist / step),
-                        )
-                        - 1
-                    )
-                    q = poses[i].copy()
-                    for _ in range(k):
-                        q[:2] += dd / (k + 1.0)
-                        q[2] = wrap_angle(float(q[2] + rot / (k + 1.0)))
-                        if self._blocked(cm, *map(float, q)):
-                            return False
-        return True
+        """TEB's ``isTrajectoryFeasible`` on the band (:mod:`.feasibility`)."""
+        return self._check.feasible(cm, self.band.poses, self.params)
 
     # ------------------------------------------------------------------ command
     def _backwards_when_stuck(
