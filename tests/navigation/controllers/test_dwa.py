@@ -11,7 +11,7 @@ from roverlab.geometry import SE2
 from roverlab.navigation.controllers import DWAParams, DWAPlanner, Velocity2D
 from roverlab.navigation.controllers.dwa import velocity_iterator
 from roverlab.navigation.costmap import Costmap2D, footprint_from_radius
-from roverlab.navigation.costmap.kernels import footprint_cost
+from roverlab.navigation.costmap.footprint_kernels import footprint_cost
 from roverlab.navigation.errors import InvalidPathError, NavigationParamsError, NoValidControlError
 from tests.navigation.controllers.conftest import DWA
 from tests.navigation.controllers.sim import ROBOT_RADIUS, field_world, run

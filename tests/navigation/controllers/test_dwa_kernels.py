@@ -21,7 +21,8 @@ from roverlab.navigation.controllers.dwa.kernels import (
 from roverlab.navigation.controllers.dwa.planner import _adjust_resolution
 from roverlab.navigation.controllers.dwa.rollouts import rollout, shared_rollout
 from roverlab.navigation.costmap import Costmap2D
-from roverlab.navigation.costmap.kernels import bresenham, footprint_cost
+from roverlab.navigation.costmap.footprint_kernels import footprint_cost
+from roverlab.navigation.costmap.kernels import bresenham
 from roverlab.navigation.errors import NoValidControlError
 
 BOX = np.array([[-0.2, -0.15], [-0.2, 0.15], [0.2, 0.15], [0.2, -0.15]])

@@ -28,7 +28,7 @@ from numpy.typing import ArrayLike, NDArray
 from roverlab.geometry import SE2, wrap_angle
 from roverlab.navigation.controllers import Velocity2D
 from roverlab.navigation.costmap.costmap_2d import Costmap2D
-from roverlab.navigation.costmap.kernels import footprint_cost
+from roverlab.navigation.costmap.footprint_kernels import footprint_cost
 from roverlab.navigation.params import build_params, check
 
 __all__ = [

@@ -18,7 +18,7 @@ from numpy.typing import ArrayLike
 
 from roverlab.geometry import SE2, wrap_angle
 from roverlab.navigation.costmap.costmap_2d import Costmap2D
-from roverlab.navigation.costmap.kernels import footprint_cost
+from roverlab.navigation.costmap.footprint_kernels import footprint_cost
 from roverlab.navigation.costmap.layered import CostmapLayer, LayeredCostmap
 from roverlab.navigation.costmap.obstacle_layer import ObstacleLayer
 from roverlab.navigation.errors import NavigationParamsError

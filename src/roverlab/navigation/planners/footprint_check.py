@@ -27,7 +27,7 @@ from numpy.typing import ArrayLike, NDArray
 from roverlab.geometry import SE2
 from roverlab.navigation.costmap.costmap_2d import LETHAL_OBSTACLE, Costmap2D
 from roverlab.navigation.costmap.footprint import footprint_radii, pad_footprint
-from roverlab.navigation.costmap.kernels import outline_cells
+from roverlab.navigation.costmap.footprint_kernels import outline_cells
 from roverlab.navigation.errors import PlannerError
 from roverlab.navigation.planners.base import Path2D, PlannerProtocol
 

@@ -24,7 +24,7 @@ from roverlab.navigation.costmap.costmap_2d import (
     LETHAL_OBSTACLE,
     Costmap2D,
 )
-from roverlab.navigation.costmap.kernels import footprint_cost, outline_cells
+from roverlab.navigation.costmap.footprint_kernels import footprint_cost, outline_cells
 
 __all__ = ["EscapeMixin"]
 

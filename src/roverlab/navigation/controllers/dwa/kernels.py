@@ -30,7 +30,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from roverlab.navigation.controllers.dwa.rollouts import rollout, shared_rollout
-from roverlab.navigation.costmap.kernels import cells_cost, footprint_cells
+from roverlab.navigation.costmap.footprint_kernels import cells_cost, footprint_cells
 
 __all__ = [
     "first_known_stretch",
