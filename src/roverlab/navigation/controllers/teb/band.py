@@ -10,7 +10,7 @@ from numpy.typing import NDArray
 
 from roverlab.geometry import wrap_angle
 
-__all__ = ["TimedElasticBand", "estimate_delta_t"]
+__all__ = ["TimedElasticBand", "estimate_delta_t", "goal_behind"]
 
 
 def estimate_delta_t(
@@ -24,6 +24,13 @@ def estimate_delta_t(
     if max_vel_theta > 0:
         dt = max(dt, abs(wrap_angle(float(end[2] - start[2]))) / max_vel_theta)
     return dt
+
+
+def goal_behind(start: NDArray[np.float64], goal: NDArray[np.float64]) -> bool:
+    """Whether ``goal`` lies behind the pose ``start`` (x, y, yaw): TEB's guess for
+    ``allow_init_with_backwards_motion``."""
+    d = goal[:2] - start[:2]
+    return float(d @ [math.cos(start[2]), math.sin(start[2])]) < 0
 
 
 def _average(a: NDArray[np.float64], b: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -77,10 +84,7 @@ class TimedElasticBand:
         goal = plan[-1].copy()
         poses = [start]
         dts: list[float] = []
-        backwards = False
-        if guess_backwards:
-            d = goal[:2] - start[:2]
-            backwards = float(d @ [math.cos(start[2]), math.sin(start[2])]) < 0
+        backwards = guess_backwards and goal_behind(start, goal)
         taken = [0]
         for i in range(1, len(plan) - 1):
             last = plan[taken[-1]]

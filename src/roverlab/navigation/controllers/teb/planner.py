@@ -44,7 +44,7 @@ from scipy.spatial import cKDTree
 
 from roverlab.geometry import SE2, wrap_angle
 from roverlab.navigation.controllers.base import Velocity2D, angle_diff, as_plan, stopped
-from roverlab.navigation.controllers.teb.band import TimedElasticBand
+from roverlab.navigation.controllers.teb.band import TimedElasticBand, goal_behind
 from roverlab.navigation.controllers.teb.feasibility import FootprintCheck
 from roverlab.navigation.controllers.teb.kernels import (
     associate_obstacles,
@@ -148,8 +148,6 @@ class TebPlanner:
     def __init__(self, params: TebParams | None = None, *, footprint: ArrayLike = ()) -> None:
         self.params = params or TebParams()
         self._check = FootprintCheck(footprint)
-        self.footprint = self._check.footprint
-        self.inscribed_radius = self._check.inscribed_radius
         self.band = TimedElasticBand()
         self.obstacles: NDArray[np.float64] = np.zeros((0, 2))
         self._obstacle_tree: cKDTree | None = None
@@ -165,6 +163,11 @@ class TebPlanner:
         self._preferred_rotdir = 0  # TEB's RotType: +1 left, -1 right, 0 none
         self._last_cmd = Velocity2D()
         self._infeasible_cycles = 0  # control cycles in a row without a valid command
+
+    @property
+    def footprint(self) -> NDArray[np.float64]:
+        """The costmap's footprint the feasibility check tests, ``(N, 2)``."""
+        return self._check.footprint
 
     @property
     def trajectory(self) -> NDArray[np.float64]:
@@ -388,7 +391,7 @@ class TebPlanner:
 
     # ------------------------------------------------------------------ command
     def _backwards_when_stuck(
-        self, local: NDArray[np.float64], twist: Velocity2D, costmap: Costmap2D, spacing: float
+        self, local: NDArray[np.float64], twist: Velocity2D, costmap: Costmap2D
     ) -> bool:
         """``backwards_init_when_stuck``: after that long without a feasible band, and with
         the local goal behind the robot, a band initialised backwards, optimised and
@@ -398,23 +401,15 @@ class TebPlanner:
             p.backwards_init_when_stuck <= 0
             or p.allow_init_with_backwards_motion  # the first band was already one
             or self._infeasible_cycles < p.backwards_init_when_stuck * p.controller_frequency
+            or not goal_behind(local[0], local[-1])  # ahead: the same band as the first
         ):
             return False
-        start, goal = local[0], local[-1]
-        if float((goal[:2] - start[:2]) @ [math.cos(start[2]), math.sin(start[2])]) >= 0:
-            return False  # ahead: the backwards guess gives the same band
-        band = self.band
-        band.clear()
-        band.init_from_plan(
-            local, p.max_vel_x, p.max_vel_theta, p.global_plan_overwrite_orientation,
-            p.min_samples, True, spacing,
-        )  # fmt: skip
+        self._init_band(local, backwards=True)
         try:
-            self._optimize(twist, p.free_goal_vel)
-        except (ValueError, TypeError, np.linalg.LinAlgError):
+            self._solve(twist)
+        except NoValidControlError:
             return False
-        finite = np.isfinite(band.poses).all() and np.isfinite(band.dts).all()
-        return bool(finite) and self._feasible(costmap)
+        return self._feasible(costmap)
 
     def _velocity_command(self) -> Velocity2D:
         p = self.params
@@ -488,6 +483,36 @@ class TebPlanner:
         self._infeasible_cycles = 0
         return cmd
 
+    def _init_band(self, local: NDArray[np.float64], *, backwards: bool) -> None:
+        """A new band from the local plan (TEB's ``initTrajectoryToGoal``), ``backwards``
+        guessed from where the local goal lies when set, at the spacing ``autoResize``
+        keeps."""
+        p = self.params
+        spacing = max((p.dt_ref - p.dt_hysteresis) * p.max_vel_x if p.teb_autosize else 0.0, 0.0)
+        self.band.clear()
+        self.band.init_from_plan(
+            local, p.max_vel_x, p.max_vel_theta, p.global_plan_overwrite_orientation,
+            p.min_samples, backwards, spacing,
+        )  # fmt: skip
+
+    def _solve(self, twist: Velocity2D) -> None:
+        """Optimise the band.
+
+        Raises:
+            NoValidControlError: the solver failed or the band diverged (it is cleared).
+        """
+        band = self.band
+        try:
+            self._optimize(twist, self.params.free_goal_vel)
+        except (ValueError, TypeError, np.linalg.LinAlgError) as err:
+            band.clear()
+            raise NoValidControlError(
+                f"teb_local_planner was not able to obtain a local plan ({err})"
+            ) from err
+        if not np.isfinite(band.poses).all() or not np.isfinite(band.dts).all():
+            band.clear()
+            raise NoValidControlError("teb_local_planner: the trajectory has diverged")
+
     def _cycle(
         self, pose: SE2, twist: Velocity2D, costmap: Costmap2D, local: NDArray[np.float64],
         goal_idx: int,
@@ -509,7 +534,6 @@ class TebPlanner:
             raise NoValidControlError("teb_local_planner: optimization_activate is false")
         start, goal = local[0], local[-1]
         band = self.band
-        spacing = max((p.dt_ref - p.dt_hysteresis) * p.max_vel_x if p.teb_autosize else 0.0, 0.0)
         if band.is_init and (
             math.hypot(*(goal[:2] - band.poses[-1, :2])) < p.force_reinit_new_goal_dist
             and abs(wrap_angle(float(goal[2] - band.poses[-1, 2])))
@@ -517,24 +541,9 @@ class TebPlanner:
         ):
             band.update_and_prune(start, goal, p.min_samples)
         else:
-            band.clear()
-            band.init_from_plan(
-                local, p.max_vel_x, p.max_vel_theta, p.global_plan_overwrite_orientation,
-                p.min_samples, p.allow_init_with_backwards_motion, spacing,
-            )  # fmt: skip
-        try:
-            self._optimize(twist, p.free_goal_vel)
-        except (ValueError, TypeError, np.linalg.LinAlgError) as err:
-            band.clear()
-            raise NoValidControlError(
-                f"teb_local_planner was not able to obtain a local plan ({err})"
-            ) from err
-        if not np.isfinite(band.poses).all() or not np.isfinite(band.dts).all():
-            band.clear()
-            raise NoValidControlError("teb_local_planner: the trajectory has diverged")
-        if not self._feasible(costmap) and not self._backwards_when_stuck(
-            local, twist, costmap, spacing
-        ):
+            self._init_band(local, backwards=p.allow_init_with_backwards_motion)
+        self._solve(twist)
+        if not self._feasible(costmap) and not self._backwards_when_stuck(local, twist, costmap):
             band.clear()
             raise NoValidControlError("teb_local_planner: trajectory is not feasible")
         try:
