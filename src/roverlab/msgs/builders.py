@@ -14,6 +14,7 @@ values, ranges) are stored as given, not copied.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable
 from typing import Any
 
@@ -348,12 +349,7 @@ class DeferredLaserScan(_LaserScan):  # type: ignore[misc,valid-type]
         d.pop("_make", None)
 
     def __reduce__(self) -> tuple[Any, tuple[Any, ...]]:
-        fields = (
-            self.header, self.angle_min, self.angle_max, self.angle_increment,
-            self.time_increment, self.scan_time, self.range_min, self.range_max, self.ranges,
-            self.intensities,
-        )  # fmt: skip
-        return _LaserScan, fields
+        return _LaserScan, tuple(getattr(self, f.name) for f in dataclasses.fields(_LaserScan))
 
 
 def laser_scan_later(
