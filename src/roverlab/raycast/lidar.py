@@ -290,17 +290,30 @@ def _run_scene(
     unit: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
     out: NDArray[np.float64] | None = None,
 ) -> NDArray[np.float64]:
-    g: Grid = scene_grid(scene)
     ca, sa = _unit_vectors(angles) if unit is None else unit
     if out is None:
         out = np.empty((poses.shape[0], angles.shape[0]), dtype=np.float64)
-    _cast_2d_kernel(
-        poses, z, angles, ca, sa, rmax,
+    _cast_2d_kernel(poses, z, angles, ca, sa, rmax, *_scene_args(scene), out)
+    return out
+
+
+_F64 = NDArray[np.float64]
+_I32 = NDArray[np.int32]
+_SceneArgs = tuple[_F64, _F64, _F64, _F64, float, float, float, int, int, _I32, _I32, int]
+
+
+def _scene_args(scene: Scene) -> _SceneArgs:
+    """The scene's arrays and grid as :func:`_cast_2d_kernel` takes them."""
+    g: Grid = scene_grid(scene)
+    return (
         scene.segments, scene.segment_z, scene.circles, scene.circle_z,
         g.x0, g.y0, g.cell, g.nx, g.ny, g.cell_start, g.items, g.n_segments,
-        out,
     )  # fmt: skip
-    return out
+
+
+def _check_pose(x: float, y: float, z: float, yaw: float) -> None:
+    if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z) and math.isfinite(yaw)):
+        raise RaycastInputError(f"lidar pose must be finite, got ({x}, {y}, {z}, {yaw})")
 
 
 class Fan:
@@ -330,8 +343,7 @@ class Fan:
         Raises:
             RaycastInputError: a non-finite pose.
         """
-        if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z) and math.isfinite(yaw)):
-            raise RaycastInputError(f"lidar pose must be finite, got ({x}, {y}, {z}, {yaw})")
+        _check_pose(x, y, z, yaw)
         pose = self._pose[0]
         pose[0], pose[1], pose[2] = x, y, yaw
         _run_scene(scene, self._pose, z, self.angles, self.range_max, self._unit, self._out)
@@ -347,18 +359,13 @@ class Fan:
         Raises:
             RaycastInputError: a non-finite pose (now, as :meth:`cast`).
         """
-        if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z) and math.isfinite(yaw)):
-            raise RaycastInputError(f"lidar pose must be finite, got ({x}, {y}, {z}, {yaw})")
-        g: Grid = scene_grid(scene)
-        arrays = (scene.segments, scene.segment_z, scene.circles, scene.circle_z)
+        _check_pose(x, y, z, yaw)
+        args = _scene_args(scene)
         angles, (ca, sa), rmax = self.angles, self._unit, self.range_max
 
         def cast() -> NDArray[np.float64]:
             out = np.empty((1, angles.shape[0]), dtype=np.float64)
-            _cast_2d_kernel(
-                np.array([[x, y, yaw]]), z, angles, ca, sa, rmax, *arrays,
-                g.x0, g.y0, g.cell, g.nx, g.ny, g.cell_start, g.items, g.n_segments, out,
-            )  # fmt: skip
+            _cast_2d_kernel(np.array([[x, y, yaw]]), z, angles, ca, sa, rmax, *args, out)
             return out[0]
 
         return cast
