@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 from roverlab.geometry import SE2
-from roverlab.navigation.controllers import TebPlanner, Velocity2D
+from roverlab.navigation.controllers import TebParams, TebPlanner, Velocity2D
 from roverlab.navigation.costmap import Costmap2D, pad_footprint
-from roverlab.navigation.errors import NoValidControlError
+from roverlab.navigation.errors import NavigationParamsError, NoValidControlError
 from tests.navigation.controllers.test_teb import _BODY, _jackal
 
 PADDED = pad_footprint(_BODY, 0.1)  # BARN's costmap footprint: 0.62 x 0.53 m
@@ -76,3 +76,9 @@ def test_backwards_init_when_stuck_backs_out_of_the_pocket() -> None:
             break
         cmd = teb.compute_velocity(SE2(x, y, th), Velocity2D(cmd.vx, 0.0, cmd.wz), WEST_PLAN, cm)
     assert x < 1.0, (x, y, th)  # out of the pocket (its mouth is at x 1.6)
+
+
+def test_backwards_init_when_stuck_refuses_a_negative_or_non_finite_time() -> None:
+    for bad in (-1.0, float("nan"), "soon"):
+        with pytest.raises(NavigationParamsError, match="backwards_init_when_stuck"):
+            TebParams.from_ros({"backwards_init_when_stuck": bad})

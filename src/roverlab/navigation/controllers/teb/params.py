@@ -254,6 +254,7 @@ class TebParams:
         check(self.max_samples >= self.min_samples, f"{w}: max_samples must be >= min_samples")
         check(self.max_vel_x > 0, f"{w}: max_vel_x must be > 0")
         check(self.max_vel_x_backwards >= 0, f"{w}: max_vel_x_backwards must be >= 0")
+        check(self.backwards_init_when_stuck >= 0, f"{w}: backwards_init_when_stuck must be >= 0")
         check(self.max_vel_theta > 0, f"{w}: max_vel_theta must be > 0")
         for name in ("acc_lim_x", "acc_lim_theta"):
             check(getattr(self, name) > 0, f"{w}: {name} must be > 0")
