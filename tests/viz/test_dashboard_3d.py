@@ -55,11 +55,15 @@ def _open(browser: Any, server: DashboardServer, ready: str, timeout_ms: int = 6
         " && viz.data.state.robot3d.length > 0 && (" + ready + ")",
         timeout=timeout_ms,
     )
-    # the page draws only when something changed: one more frame, with all that arrived
-    drawn = page.evaluate("() => { viz.requestDraw(); return viz.cam.frames; }")
-    page.wait_for_function(f"() => viz.cam.frames > {drawn}")
+    _next_frame(page)
     page.errors = errors
     return page
+
+
+def _next_frame(page: Any) -> None:
+    """The page draws only when something changed: one more frame, with all that arrived."""
+    drawn = page.evaluate("() => { viz.requestDraw(); return viz.cam.frames; }")
+    page.wait_for_function(f"() => viz.cam.frames > {drawn}")
 
 
 def _shot(page: Any, path: Path) -> np.ndarray:
@@ -126,6 +130,7 @@ def test_mycar_cloud_and_links_in_the_orbit_view(
         " viz.cam.yaw = Math.atan2(1.5, 2.0) + Math.PI; viz.cam.pitch = 0.45; }"
     )
     page.wait_for_timeout(800)
+    _next_frame(page)  # drawn from the new camera (800 ms alone missed it once under load)
     img = _shot(page, tmp_path / "mycar_orbit.png")
     cloud = page.evaluate(
         "() => { const l = viz.data.layers.find(l => l && l.points); const s = l.points.at(-1);"
